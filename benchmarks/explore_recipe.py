@@ -1,0 +1,46 @@
+"""Exploration: train on the authors' data with periodic test evaluation (learning curve).
+
+    python benchmarks/explore_recipe.py --epochs 300 --seed 0 [--set key=value ...]
+"""
+import argparse, json, time
+from pathlib import Path
+
+import torch
+
+from pgae_lite.config import get_profile
+from pgae_lite.data import load_original
+from pgae_lite.evaluate import evaluate
+from pgae_lite.train import train
+
+ap = argparse.ArgumentParser()
+ap.add_argument("--data", default="../shared/pgae-original-data")
+ap.add_argument("--epochs", type=int, default=300)
+ap.add_argument("--seed", type=int, default=0)
+ap.add_argument("--every", type=int, default=25)
+ap.add_argument("--threads", type=int, default=2)
+ap.add_argument("--set", nargs="*", default=[], help="TrainConfig overrides key=value")
+ap.add_argument("--log", default=None)
+a = ap.parse_args()
+torch.set_num_threads(a.threads)
+over = {k: json.loads(v) for k, v in (s.split("=", 1) for s in a.set)}
+prof = get_profile("book", epochs=a.epochs, seed=a.seed, **over)
+ds = load_original(a.data)
+t0 = time.perf_counter()
+rows = []
+
+def cb(epoch, model, rec):
+    if epoch % a.every and epoch != a.epochs:
+        return
+    t = time.perf_counter() - t0
+    from pgae_lite.data import Normaliser
+    res, _ = evaluate(model, ds, Normaliser.fit(ds.split("train")))
+    line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
+            **{k[:6] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
+            "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}
+    rows.append(line)
+    print(json.dumps(line), flush=True)
+
+tr = train(ds, prof, progress=False, callback=cb)
+print("train seconds", round(tr.seconds))
+if a.log:
+    Path(a.log).write_text(json.dumps(rows))

@@ -1,0 +1,84 @@
+"""Configurations and profiles.
+
+A profile is a complete recipe (model + training). Three are built in:
+
+- ``smoke``: seconds; for CI and for checking that a notebook runs.
+- ``book`` (default): minutes on a 2-core laptop CPU, near-paper quality.
+- ``paper``: the paper's hyperparameters (Adam 1e-5, batch 6, 6000 epochs,
+  peephole cells, one signal per batch, no teacher forcing); for a GPU.
+
+The environment variable ``PGAE_LITE_PROFILE`` picks the default profile.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass, field, replace
+
+from .pgae import ModelConfig
+
+PROFILE_ENV = "PGAE_LITE_PROFILE"
+
+
+@dataclass
+class TrainConfig:
+    """How PGAE is trained. Defaults are the ``book`` recipe."""
+
+    epochs: int = 300
+    batch_size: int = 64
+    # Deviation from paper: Adam 2e-3 with warm-up and cosine decay (paper: 1e-5, constant).
+    lr: float = 2e-3
+    schedule: str = "cosine"            # "cosine" (warm-up, then cosine to 0) or "constant"
+    warmup: float = 0.03                # fraction of steps of linear warm-up
+    clip: float | None = 1.0            # gradient-norm clipping (paper: none)
+    # Deviation from paper: a signal per sample (authors: one per batch).
+    signals_per_sample: bool = True
+    # Deviation from paper: the language decoder is teacher-forced in training
+    # (authors: it feeds back its own softmax, in training and at test time).
+    teacher_language: bool = True
+    # Deviation from paper: the action decoder gets the recorded joints for this
+    # fraction of training, then its own predictions (authors: 0, always its own).
+    teacher_joints_until: float = 0.75
+    opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
+    language_weight: float = 1.0        # α
+    action_weight: float = 1.0          # β
+    seed: int = 0
+    max_train_samples: int | None = None  # a subset of the training split (smoke tests)
+    checkpoint_every: int = 25          # epochs between checkpoints
+
+
+@dataclass
+class Profile:
+    """A named recipe: model and training configuration."""
+
+    name: str
+    model: ModelConfig = field(default_factory=ModelConfig)
+    train: TrainConfig = field(default_factory=TrainConfig)
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "model": asdict(self.model), "train": asdict(self.train)}
+
+
+PROFILES: dict[str, Profile] = {
+    "smoke": Profile("smoke", ModelConfig(units=32), TrainConfig(
+        epochs=3, batch_size=32, lr=3e-3, max_train_samples=96, checkpoint_every=1)),
+    "book": Profile("book"),
+    "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
+        epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
+        signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0,
+        checkpoint_every=100)),
+}
+
+
+def get_profile(name: str | None = None, **train_overrides) -> Profile:
+    """A copy of a built-in profile; ``name=None`` reads ``PGAE_LITE_PROFILE`` (default ``book``).
+
+    Keyword arguments override fields of its :class:`TrainConfig`, e.g. ``seed=1``.
+    """
+    name = name or os.environ.get(PROFILE_ENV, "book")
+    if name not in PROFILES:
+        raise ValueError(f"unknown profile {name!r}; the profiles are: {', '.join(PROFILES)}")
+    p = PROFILES[name]
+    bad = set(train_overrides) - set(asdict(p.train))
+    if bad:
+        raise ValueError(f"unknown training option(s) {sorted(bad)}; the options are: {', '.join(asdict(p.train))}")
+    return Profile(p.name, replace(p.model), replace(p.train, **train_overrides))

@@ -1,0 +1,172 @@
+"""The language side of PGAE: vocabulary, synonyms, signals and descriptions.
+
+Paper, Sec. 4 (Dataset) and Sec. 3 (Language Autoencoder). A description has
+the grammar ``action colour speed``; every word has one synonym, so one
+meaning has 2 x 2 x 2 = 8 equivalent descriptions. The vocabulary has 22
+words plus ``<BOS/EOS>`` (23). Five signal phrases tell the model what to do;
+they are appended as 5 extra input dimensions (23 + 5 = 28).
+
+User text is parsed leniently (case, extra spaces, ``move up`` for
+``move-up``); anything else raises :class:`LanguageError`, which names the
+offending word and lists what is allowed.
+"""
+from __future__ import annotations
+
+import itertools
+import re
+
+import torch
+
+BOS_EOS = "<BOS/EOS>"
+
+#: The 23 output words, in the index order of the authors' ``vocabulary.txt``.
+VOCABULARY: tuple[str, ...] = (
+    BOS_EOS, "azure", "blonde", "blue", "cyan", "fast", "green", "greenish-blue",
+    "harlequin", "move-down", "move-sideways", "move-up", "pull", "purple", "push",
+    "quickly", "red", "scarlet", "slide", "slowly", "unhurriedly", "violet", "yellow",
+)
+WORD_INDEX: dict[str, int] = {w: i for i, w in enumerate(VOCABULARY)}
+
+#: The five signals, in the index order of the authors' ``vocabulary.txt``.
+SIGNALS: tuple[str, ...] = ("describe", "execute", "repeat action", "repeat both", "repeat language")
+#: Signals used at test time (``repeat both`` is for training only).
+TEST_SIGNALS: tuple[str, ...] = ("describe", "repeat language", "execute", "repeat action")
+
+#: Input dimensions of the language encoder: 23 words + 5 signal tokens.
+INPUT_DIM = len(VOCABULARY) + len(SIGNALS)
+
+#: Each canonical word and its synonym (the paper's one-to-many mapping).
+SYNONYMS: dict[str, str] = {
+    "push": "move-up", "pull": "move-down", "slide": "move-sideways",
+    "red": "scarlet", "green": "harlequin", "blue": "azure",
+    "yellow": "blonde", "cyan": "greenish-blue", "violet": "purple",
+    "slowly": "unhurriedly", "fast": "quickly",
+}
+ACTIONS: tuple[str, ...] = ("push", "pull", "slide")
+COLOURS: tuple[str, ...] = ("red", "green", "blue", "yellow", "cyan", "violet")
+SPEEDS: tuple[str, ...] = ("slowly", "fast")
+#: The grammar: which canonical words may stand at each of the three positions.
+SLOTS: tuple[tuple[str, ...], ...] = (ACTIONS, COLOURS, SPEEDS)
+SLOT_NAMES: tuple[str, ...] = ("action", "colour", "speed")
+
+CANONICAL: dict[str, str] = {**{w: w for w in SYNONYMS}, **{s: w for w, s in SYNONYMS.items()}}
+
+#: Inverse-frequency word weights of the weighted cross-entropy (authors' code).
+WORD_WEIGHTS: dict[str, float] = {
+    BOS_EOS: 0.1168, **{w: 1.4010 for c in COLOURS for w in (c, SYNONYMS[c])},
+    **{w: 0.7005 for a in ACTIONS for w in (a, SYNONYMS[a])},
+    **{w: 0.4670 for s in SPEEDS for w in (s, SYNONYMS[s])},
+}
+
+
+class LanguageError(ValueError):
+    """Bad user text or signal; the message says what was wrong and what is allowed."""
+
+
+def word_weights() -> torch.Tensor:
+    """The 23 cross-entropy weights in vocabulary order, shape (23,)."""
+    return torch.tensor([WORD_WEIGHTS[w] for w in VOCABULARY])
+
+
+def normalise_signal(signal: str) -> str:
+    """Return the canonical signal name; accepts ``repeat_action``, ``Repeat Action:``…"""
+    key = re.sub(r"[\s_:-]+", " ", str(signal)).strip().lower()
+    if key not in SIGNALS:
+        raise LanguageError(f"unknown signal {signal!r}; the signals are: {', '.join(SIGNALS)}")
+    return key
+
+
+def signal_index(signal: str) -> int:
+    """Index of a signal among the 5 signal tokens (input dimension 23 + index)."""
+    return SIGNALS.index(normalise_signal(signal))
+
+
+def tokenize(text: str) -> list[str]:
+    """Split user text into vocabulary words, leniently.
+
+    Case and extra spaces are ignored and two-word synonyms may be written with
+    a space (``move up``, ``greenish blue``). An unknown word raises
+    :class:`LanguageError` naming it and listing the vocabulary.
+    """
+    words = str(text).lower().replace(BOS_EOS.lower(), " ").split()
+    tokens: list[str] = []
+    i = 0
+    while i < len(words):
+        pair = "-".join(words[i:i + 2])
+        if i + 1 < len(words) and pair in WORD_INDEX:
+            tokens.append(pair)
+            i += 2
+        elif words[i] in WORD_INDEX:
+            tokens.append(words[i])
+            i += 1
+        else:
+            vocab = ", ".join(sorted(w for w in VOCABULARY if w != BOS_EOS))
+            raise LanguageError(f"unknown word {words[i]!r} in {text!r}; the vocabulary is: {vocab}")
+    return tokens
+
+
+def parse_description(text: str) -> tuple[str, str, str]:
+    """Parse ``action colour speed`` into canonical words, e.g. ``('push', 'red', 'fast')``.
+
+    Raises :class:`LanguageError` for unknown words, a wrong length or a word in
+    the wrong position (the message says which word each position allows).
+    """
+    tokens = tokenize(text)
+    if len(tokens) != 3:
+        raise LanguageError(
+            f"a description has 3 words (action colour speed), got {len(tokens)} in {text!r}")
+    canon = []
+    for token, slot, name in zip(tokens, SLOTS, SLOT_NAMES):
+        word = CANONICAL.get(token)
+        if word not in slot:
+            allowed = ", ".join(w2 for w in slot for w2 in (w, SYNONYMS[w]))
+            raise LanguageError(f"{token!r} cannot be the {name} word in {text!r}; allowed: {allowed}")
+        canon.append(word)
+    return tuple(canon)  # type: ignore[return-value]
+
+
+def equivalent_descriptions(action: str, colour: str, speed: str) -> list[tuple[str, str, str]]:
+    """The 8 equivalent descriptions of one meaning (each word or its synonym).
+
+    Order follows the authors' data: canonical first, the action word's
+    synonym varying fastest, then the colour's, then the speed's.
+    """
+    words = parse_description(f"{action} {colour} {speed}")
+    choices = [(w, SYNONYMS[w]) for w in reversed(words)]   # speed, colour, action
+    return [tuple(reversed(c)) for c in itertools.product(*choices)]
+
+
+def encode(words: tuple[str, ...] | list[str]) -> torch.Tensor:
+    """Word list -> index tensor with ``<BOS/EOS>`` at both ends, shape (len + 2,)."""
+    return torch.tensor([0] + [WORD_INDEX[w] for w in words] + [0])
+
+
+def one_hot(indices: torch.Tensor, dim: int = len(VOCABULARY)) -> torch.Tensor:
+    """Indices (...,) -> one-hot float vectors (..., dim)."""
+    return torch.nn.functional.one_hot(indices.long(), dim).float()
+
+
+def decode(indices: torch.Tensor | list[int]) -> str:
+    """Generated word indices (or one-hot / probability rows) -> text.
+
+    Reading stops at the first ``<BOS/EOS>``, so an output of ``<EOS>`` alone gives ``""``.
+    """
+    t = torch.as_tensor(indices)
+    if t.dim() == 2:  # (steps, 23) one-hot or probabilities
+        t = t.argmax(-1)
+    words = []
+    for i in t.tolist():
+        if i == 0:
+            break
+        words.append(VOCABULARY[i])
+    return " ".join(words)
+
+
+def is_correct(generated: str, alternatives: list[tuple[str, ...]] | None) -> bool:
+    """Paper's criterion: every word matches one of the equivalent descriptions.
+
+    ``alternatives=None`` means the expected output is ``<EOS>`` alone (empty text).
+    """
+    if alternatives is None:
+        return generated == ""
+    return tuple(generated.split()) in {tuple(a) for a in alternatives}

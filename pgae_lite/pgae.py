@@ -1,0 +1,165 @@
+"""PGAE: paired gated autoencoders (paper Sec. 3, Fig. 3).
+
+Two autoencoders, language and action, joined in a GMU bottleneck:
+
+    f_lang = LanguageEncoder(signal + words)          (Sec. 3, Language Autoencoder)
+    f_act  = ActionEncoder([v_t; j_t] for each step)   (Sec. 3, Action Autoencoder)
+    h, z   = GMU(f_act, f_lang)                        (Sec. 3, Bottleneck)
+    words  = LanguageDecoder(h)                        autoregressive from <BOS>
+    joints = ActionDecoder(h, vision, start joints)    j_{t+1} = tanh(W y_t + b)
+
+Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50,
+30 visual features and 5 joints per step.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+from torch import nn
+
+from .data import JOINT_DIM, VISION_DIM
+from .language import INPUT_DIM, VOCABULARY
+from .layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
+from .signals import SignalBatch
+
+WORDS = len(VOCABULARY)
+
+
+@dataclass
+class ModelConfig:
+    """Architecture of PGAE (defaults: the authors' code)."""
+
+    units: int = 100
+    layers: int = 2
+    hidden: int = 50
+    cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
+
+    @property
+    def state_dim(self) -> int:
+        return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
+
+
+class LanguageEncoder(nn.Module):
+    """LSTM over one-hot tokens (signal first); f = final [c; h] of every layer."""
+
+    def __init__(self, cfg: ModelConfig):
+        super().__init__()
+        self.rnn = make_recurrent(cfg.cell, INPUT_DIM, cfg.units, cfg.layers)
+
+    def forward(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
+        x = nn.functional.one_hot(tokens, INPUT_DIM).float()   # (B, 5, 28)
+        _, state = self.rnn(x, lengths)
+        return state_to_vector(state)                           # (B, 400)
+
+
+class ActionEncoder(nn.Module):
+    """LSTM over [visual features; joints] per step; f = final [c; h] of every layer."""
+
+    def __init__(self, cfg: ModelConfig):
+        super().__init__()
+        self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
+
+    def forward(self, inputs: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
+        _, state = self.rnn(inputs, lengths)                    # inputs (B, T, 35)
+        return state_to_vector(state)                           # (B, 400)
+
+
+class LanguageDecoder(nn.Module):
+    """Generates w_1..w_4 from h, starting from <BOS>; softmax over the 23 words."""
+
+    def __init__(self, cfg: ModelConfig):
+        super().__init__()
+        self.layers = cfg.layers
+        self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)   # initial state = W h + b
+        self.rnn = make_recurrent(cfg.cell, WORDS, cfg.units, cfg.layers)
+        self.out = nn.Linear(cfg.units, WORDS)
+
+    def forward(self, h: torch.Tensor, target: torch.Tensor | None = None, steps: int = 4,
+                feedback: str = "greedy") -> torch.Tensor:
+        """Logits (B, steps, 23).
+
+        ``target`` given: teacher forcing, the inputs are <BOS> and the target's
+        words (one fused pass). Otherwise autoregressive: ``feedback="greedy"``
+        feeds the argmax word back, ``"soft"`` the softmax (authors' code).
+        """
+        state = vector_to_state(self.init_state(h), self.layers)
+        bos = h.new_zeros(h.shape[0], 1, WORDS)
+        bos[..., 0] = 1.0
+        if target is not None:
+            x = torch.cat([bos, nn.functional.one_hot(target[:, :-1], WORDS).float()], 1)  # (B, 4, 23)
+            y, _ = self.rnn(x, None, state)
+            return self.out(y)
+        x, logits = bos[:, 0], []
+        for _ in range(steps):
+            y, state = self.rnn.step(x, state)
+            logit = self.out(y)                                 # (B, 23)
+            logits.append(logit)
+            x = (logit.softmax(-1) if feedback == "soft"
+                 else nn.functional.one_hot(logit.argmax(-1), WORDS).float())
+        return torch.stack(logits, 1)
+
+
+class ActionDecoder(nn.Module):
+    """Generates joints step by step: input [v_t; ĵ_t], output ĵ_{t+1} = tanh(W y_t + b).
+
+    The visual features v_t are the recorded ones at every step (teacher-forced,
+    as in the paper); the joints are the decoder's own previous predictions,
+    or the recorded ones when ``teacher_joints`` is given (faster training).
+    """
+
+    def __init__(self, cfg: ModelConfig):
+        super().__init__()
+        self.layers = cfg.layers
+        self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)
+        self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
+        self.out = nn.Linear(cfg.units, JOINT_DIM)
+
+    def forward(self, h: torch.Tensor, vision: torch.Tensor, start: torch.Tensor,
+                teacher_joints: torch.Tensor | None = None) -> torch.Tensor:
+        """vision (B, S, 30), start (B, 5) -> joints of steps 1..S (B, S, 5)."""
+        state = vector_to_state(self.init_state(h), self.layers)
+        if teacher_joints is not None:                          # inputs ĵ_t := recorded j_t
+            prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)   # (B, S, 5)
+            y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
+            return torch.tanh(self.out(y))
+        j, outs = start, []
+        for v_t in vision.unbind(1):                            # S x (B, 30)
+            y, state = self.rnn.step(torch.cat([v_t, j], 1), state)
+            j = torch.tanh(self.out(y))                         # ĵ_{t+1}
+            outs.append(j)
+        return torch.stack(outs, 1)
+
+
+class PGAE(nn.Module):
+    """The whole model: two encoders, the GMU, two decoders."""
+
+    def __init__(self, cfg: ModelConfig | None = None):
+        super().__init__()
+        self.cfg = cfg or ModelConfig()
+        self.language_encoder = LanguageEncoder(self.cfg)
+        self.action_encoder = ActionEncoder(self.cfg)
+        self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.cfg.state_dim, self.cfg.hidden)
+        self.language_decoder = LanguageDecoder(self.cfg)
+        self.action_decoder = ActionDecoder(self.cfg)
+
+    def encode(self, batch: SignalBatch) -> tuple[torch.Tensor, torch.Tensor]:
+        """Shared representation h and GMU gate z, each (B, hidden)."""
+        f_lang = self.language_encoder(batch.lang_tokens, batch.lang_lengths)
+        f_act = self.action_encoder(batch.action_input, batch.action_lengths)
+        return self.gmu(f_act, f_lang)
+
+    def forward(self, batch: SignalBatch, teacher_language: bool = False,
+                teacher_joints: bool = False, feedback: str = "greedy") -> dict[str, torch.Tensor]:
+        """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden)."""
+        h, z = self.encode(batch)
+        logits = self.language_decoder(
+            h, batch.lang_target if teacher_language else None, feedback=feedback)
+        joints = self.action_decoder(
+            h, batch.dec_vision, batch.start_joints, batch.joint_target if teacher_joints else None)
+        return {"logits": logits, "joints": joints, "h": h, "gate": z}
+
+
+def count_parameters(model: nn.Module) -> int:
+    """Number of trainable parameters."""
+    return sum(p.numel() for p in model.parameters() if p.requires_grad)

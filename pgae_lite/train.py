@@ -1,0 +1,194 @@
+"""Training PGAE: the loss, the loop, checkpoints (paper Sec. 3, "Loss Function", and Sec. 4).
+
+    L = α · weighted cross-entropy(words) + β · MSE(joints)
+
+The word weights counter word frequency (``<BOS/EOS>`` is in every
+description, a colour word in one of six); both terms are averaged over the
+valid steps only. Training is deterministic under a seed, runs on CUDA when
+present (else the CPU), and resumes from its last checkpoint after an
+interruption.
+"""
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import torch
+from torch import nn
+from tqdm.auto import tqdm
+
+from .config import Profile, get_profile
+from .data import Normaliser, PGAEDataset
+from .language import SIGNALS, word_weights
+from .pgae import PGAE, ModelConfig
+from .signals import SignalBatch, make_batch, sample_signals
+
+CHECKPOINT = "checkpoint.pt"
+
+
+def default_device() -> torch.device:
+    """CUDA when present, else the CPU."""
+    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+def pgae_loss(out: dict[str, torch.Tensor], batch: SignalBatch, weights: torch.Tensor,
+              alpha: float = 1.0, beta: float = 1.0) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Total, language and action loss of one batch.
+
+    language = Σ w[y] · CE(logits, y) / Σ mask  over valid words
+    action   = Σ (ĵ − j)² / (5 · Σ mask)        over valid steps
+    """
+    ce = nn.functional.cross_entropy(out["logits"].transpose(1, 2), batch.lang_target,
+                                     reduction="none")                      # (B, 4)
+    m = batch.lang_mask.float()
+    lang = (weights[batch.lang_target] * ce * m).sum() / m.sum()
+    jm = batch.joint_mask.float()[..., None]                                # (B, T-1, 1)
+    act = ((out["joints"] - batch.joint_target) ** 2 * jm).sum() / (jm.sum() * out["joints"].shape[-1])
+    return alpha * lang + beta * act, lang, act
+
+
+def lr_factor(step: int, total: int, warmup: float, schedule: str) -> float:
+    """Learning-rate multiplier: linear warm-up, then cosine decay to 0 (or constant)."""
+    warm = int(warmup * total)
+    if step < warm:
+        return (step + 1) / warm
+    if schedule == "constant":
+        return 1.0
+    progress = (step - warm) / max(1, total - warm)
+    return 0.5 * (1.0 + math.cos(math.pi * min(1.0, progress)))
+
+
+@dataclass
+class Trained:
+    """What :func:`train` returns: the model, its normaliser, the history and the wall time."""
+
+    model: PGAE
+    normaliser: Normaliser
+    history: list[dict]
+    profile: Profile
+    seconds: float
+
+
+def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
+          device: torch.device | str | None = None, progress: bool = True,
+          model: PGAE | None = None, callback=None) -> Trained:
+    """Train PGAE on the training split of ``dataset``.
+
+    With ``out_dir`` a checkpoint is written there every
+    ``checkpoint_every`` epochs and at the end (atomically); a later call with
+    the same ``out_dir`` and profile resumes from it, and one whose training
+    finished returns at once. ``callback(epoch, model, record)``, if given, is
+    called after every epoch (e.g. to evaluate along the way).
+    """
+    profile = profile if isinstance(profile, Profile) else get_profile(profile)
+    cfg = profile.train
+    device = torch.device(device) if device else default_device()
+    train_set = dataset.split("train")
+    if cfg.max_train_samples:
+        train_set = train_set.subset(slice(0, cfg.max_train_samples))
+    normaliser = Normaliser.fit(train_set)
+    data = normaliser.tensors(train_set, device)
+
+    torch.manual_seed(cfg.seed)
+    model = (model or PGAE(profile.model)).to(device)
+    optimiser = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    gen = torch.Generator().manual_seed(cfg.seed)  # signals, descriptions, views, shuffling
+    n = len(train_set)
+    batches = math.ceil(n / cfg.batch_size)
+    total = cfg.epochs * batches
+    start_epoch, history, elapsed = 0, [], 0.0
+
+    ckpt_path = Path(out_dir) / CHECKPOINT if out_dir else None
+    if ckpt_path and ckpt_path.exists():
+        ckpt = load_checkpoint(ckpt_path)
+        if ckpt["profile"] != profile.to_dict():
+            raise ValueError(f"{ckpt_path} was trained with a different profile; use another output "
+                             "folder or delete the checkpoint to start again")
+        model.load_state_dict(ckpt["model"])
+        optimiser.load_state_dict(ckpt["optimiser"])
+        gen.set_state(ckpt["generator"])
+        torch.set_rng_state(ckpt["torch_rng"])
+        start_epoch, history, elapsed = ckpt["epoch"], ckpt["history"], ckpt["seconds"]
+
+    weights = word_weights().to(device)
+    t0 = time.perf_counter() - elapsed
+    bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
+               initial=start_epoch, total=cfg.epochs)
+    for epoch in bar:
+        model.train()
+        order = torch.randperm(n, generator=gen)
+        sums = torch.zeros(3)
+        gate_sum, gate_n = torch.zeros(len(SIGNALS)), torch.zeros(len(SIGNALS))
+        teacher_joints = epoch < cfg.teacher_joints_until * cfg.epochs
+        for b in range(batches):
+            step = epoch * batches + b
+            for g in optimiser.param_groups:
+                g["lr"] = cfg.lr * lr_factor(step, total, cfg.warmup, cfg.schedule)
+            index = order[b * cfg.batch_size:(b + 1) * cfg.batch_size]
+            size = len(index)
+            signal = sample_signals(size, gen, cfg.signals_per_sample)
+            alternative = torch.randint(8, (size,), generator=gen)
+            opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
+            opposite &= signal != 1  # execute shows no action to the encoder
+            batch = make_batch(data, index, signal, alternative, opposite)
+            out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
+                        feedback="greedy" if cfg.teacher_language else "soft")
+            loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)
+            optimiser.zero_grad(set_to_none=True)
+            loss.backward()
+            if cfg.clip:
+                nn.utils.clip_grad_norm_(model.parameters(), cfg.clip)
+            optimiser.step()
+            sums += torch.tensor([loss.item(), lang.item(), act.item()]) * size
+            z = out["gate"].detach().mean(1).cpu()
+            gate_sum.index_add_(0, signal, z)
+            gate_n.index_add_(0, signal, torch.ones(size))
+        loss, lang, act = (sums / n).tolist()
+        gates = (gate_sum / gate_n.clamp(min=1)).tolist()
+        history.append({"epoch": epoch + 1, "loss": loss, "language_loss": lang, "action_loss": act,
+                        "lr": optimiser.param_groups[0]["lr"],
+                        "gate": {s: g for s, g, k in zip(SIGNALS, gates, gate_n) if k > 0}})
+        bar.set_postfix(loss=f"{loss:.4f}", lang=f"{lang:.4f}", act=f"{act:.5f}")
+        if callback is not None:
+            callback(epoch + 1, model, history[-1])
+            model.train()
+        last = epoch + 1 == cfg.epochs
+        if ckpt_path and (last or (epoch + 1) % cfg.checkpoint_every == 0):
+            save_checkpoint(ckpt_path, model, optimiser, gen, epoch + 1, history, profile, normaliser,
+                            time.perf_counter() - t0)
+    model.eval()
+    return Trained(model, normaliser, history, profile, time.perf_counter() - t0)
+
+
+def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, gen: torch.Generator,
+                    epoch: int, history: list[dict], profile: Profile, normaliser: Normaliser,
+                    seconds: float) -> None:
+    """Write a checkpoint atomically (a crash mid-write never leaves a broken file)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".tmp")
+    torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
+                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
+                "history": history, "profile": profile.to_dict(),
+                "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
+    os.replace(tmp, path)
+
+
+def load_checkpoint(path: str | Path) -> dict:
+    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only)."""
+    return torch.load(path, map_location="cpu", weights_only=True)
+
+
+def load_model(path: str | Path, device: torch.device | str | None = None) -> tuple[PGAE, Normaliser, dict]:
+    """Model (in eval mode), normaliser and the checkpoint's other contents."""
+    ckpt = load_checkpoint(path)
+    model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
+    model.load_state_dict(ckpt["model"])
+    model.to(device or default_device()).eval()
+    return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
+
+
+__all__ = ["train", "pgae_loss", "Trained", "load_model", "load_checkpoint", "save_checkpoint",
+           "default_device", "lr_factor", "asdict"]
