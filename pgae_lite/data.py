@@ -196,7 +196,12 @@ _SUBTREES = ("behavior", "vision", "vision_opp", "language")
 
 
 def _read_matrix(path: Path, width: int) -> np.ndarray:
-    values = np.array(path.read_text().split(), dtype=np.float32)
+    if not path.is_file():
+        raise DataFormatError(f"missing file {path}: every sample needs the same file name in all sub-folders")
+    try:
+        values = np.array(path.read_text().split(), dtype=np.float32)
+    except ValueError as e:
+        raise DataFormatError(f"{path}: expected rows of {width} numbers ({e})") from None
     if values.size == 0 or values.size % width:
         raise DataFormatError(f"{path}: expected rows of {width} numbers, found {values.size} numbers")
     return values.reshape(-1, width)

@@ -55,6 +55,11 @@ class PeepholeLSTM(nn.Module):
             PeepholeLSTMCell(input_size if l == 0 else hidden_size, hidden_size, forget_bias)
             for l in range(num_layers))
 
+    @property
+    def input_weight(self) -> nn.Parameter:
+        """First layer's input weights (input, 4H): for one-hot inputs, a word embedding."""
+        return self.cells[0].weight_x
+
     def zero_state(self, batch: int, like: torch.Tensor) -> State:
         z = like.new_zeros(self.num_layers, batch, self.hidden_size)
         return z, z.clone()
@@ -116,6 +121,11 @@ class FusedLSTM(nn.Module):
         with torch.no_grad():  # PyTorch's gate order is i, f, g, o: add the forget bias once
             for l in range(num_layers):
                 getattr(self.lstm, f"bias_ih_l{l}")[hidden_size:2 * hidden_size] += forget_bias
+
+    @property
+    def input_weight(self) -> nn.Parameter:
+        """First layer's input weights (4H, input): for one-hot inputs, a word embedding."""
+        return self.lstm.weight_ih_l0
 
     def forward(self, x: torch.Tensor, lengths: torch.Tensor | None = None,
                 state: State | None = None) -> tuple[torch.Tensor, State]:

@@ -40,12 +40,25 @@ class ModelConfig:
         return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
 
+def embedding_init_(rnn: nn.Module) -> None:
+    """Initialise the input weights of an LSTM fed one-hot words like a word embedding, N(0, 1).
+
+    Deviation from paper: the authors' code draws every weight from U(-0.1, 0.1).
+    With one-hot inputs that makes all words look alike to the LSTM, and the
+    language path sat on a plateau for hundreds of epochs (measured: a
+    language autoencoder stayed at chance for 1000 steps; with N(0, 1) it
+    reached 100% in 200).
+    """
+    nn.init.normal_(rnn.input_weight, 0.0, 1.0)
+
+
 class LanguageEncoder(nn.Module):
     """LSTM over one-hot tokens (signal first); f = final [c; h] of every layer."""
 
     def __init__(self, cfg: ModelConfig):
         super().__init__()
         self.rnn = make_recurrent(cfg.cell, INPUT_DIM, cfg.units, cfg.layers)
+        embedding_init_(self.rnn)
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         x = nn.functional.one_hot(tokens, INPUT_DIM).float()   # (B, 5, 28)
@@ -73,6 +86,7 @@ class LanguageDecoder(nn.Module):
         self.layers = cfg.layers
         self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)   # initial state = W h + b
         self.rnn = make_recurrent(cfg.cell, WORDS, cfg.units, cfg.layers)
+        embedding_init_(self.rnn)
         self.out = nn.Linear(cfg.units, WORDS)
 
     def forward(self, h: torch.Tensor, target: torch.Tensor | None = None, steps: int = 4,

@@ -1,0 +1,78 @@
+"""Shared fixtures: a tiny synthetic dataset and, when present, the authors' data.
+
+The authors' data (public repository oo222bs/PGAE, the folder holding
+``target/``) is looked for in ``$PGAE_ORIGINAL_DATA``, else in
+``../shared/pgae-original-data`` beside the project; tests that need it are
+skipped with a message when it is absent.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from pgae_lite.data import Normaliser, load_original
+from pgae_lite.toydata import toy_dataset
+
+ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
+
+# Tiny models run no faster on two threads, and much slower when another job shares the cores.
+torch.set_num_threads(1)
+DEFAULT_ORIGINAL_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "pgae-original-data"
+
+
+def original_data_path() -> Path:
+    return Path(os.environ.get(ORIGINAL_DATA_ENV) or DEFAULT_ORIGINAL_DATA)
+
+
+@pytest.fixture(scope="session")
+def toy():
+    """One recording of each of the 144 patterns (108 train, 36 test): fast to make."""
+    return toy_dataset(variations=1)
+
+
+def shorten(data, every: int = 10):
+    """A copy of a dataset with every ``every``-th time step (lengths 100/50 -> 10/5): fast training."""
+    short = data.subset(np.arange(len(data)))
+    for name in ("joints", "vision", "vision_opposite"):
+        setattr(short, name, np.ascontiguousarray(getattr(short, name)[:, ::every]))
+    short.lengths = -(-short.lengths // every)
+    return short
+
+
+@pytest.fixture(scope="session")
+def toy_short(toy):
+    """The toy dataset with 10x fewer time steps (10 or 5): for tests that train."""
+    return shorten(toy)
+
+
+@pytest.fixture(scope="session")
+def toy_tensors(toy):
+    """Normalised tensors of the whole toy dataset (statistics from its training split)."""
+    return Normaliser.fit(toy.split("train")).tensors(toy)
+
+
+@pytest.fixture(scope="session")
+def original_data() -> Path:
+    """Path of the authors' data folder; skips the test when it is not there."""
+    path = original_data_path()
+    if not (path / "target").is_dir():
+        pytest.skip(f"the authors' PGAE data is not at {path}: get the folder holding target/ "
+                    f"(and actions.txt) from the public GitHub repository oo222bs/PGAE and put it "
+                    f"there or set ${ORIGINAL_DATA_ENV}")
+    return path
+
+
+@pytest.fixture(scope="session")
+def original(original_data):
+    """The authors' dataset, loaded once per session (a few seconds)."""
+    return load_original(original_data)
+
+
+@pytest.fixture(autouse=True)
+def _seed():
+    """Every test starts from the same global torch seed."""
+    torch.manual_seed(0)

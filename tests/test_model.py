@@ -1,0 +1,90 @@
+"""pgae_lite.pgae: shapes, the authors' parameter count, the decoders' two modes."""
+from __future__ import annotations
+
+import pytest
+import torch
+
+from pgae_lite.pgae import PGAE, ModelConfig, count_parameters
+from pgae_lite.signals import make_batch, signal_ids
+
+INDEX = torch.tensor([72, 0, 100, 1])          # fast, slow, fast, slow (toy training samples)
+
+
+def _batch(tensors, signal="repeat both"):
+    return make_batch(tensors, INDEX, signal_ids(signal, len(INDEX)), torch.tensor([0, 1, 2, 3]))
+
+
+@pytest.mark.parametrize("cell", ["lstm", "peephole"])
+def test_shapes(toy_tensors, cell):
+    model = PGAE(ModelConfig(units=16, cell=cell))
+    out = model(_batch(toy_tensors))
+    assert out["logits"].shape == (4, 4, 23)
+    assert out["joints"].shape == (4, 99, 5)
+    assert out["gate"].shape == out["h"].shape == (4, 50)
+    assert (out["joints"].abs() <= 1).all()                       # tanh output
+    assert ((out["gate"] > 0) & (out["gate"] < 1)).all()
+    h, z = model.encode(_batch(toy_tensors))
+    torch.testing.assert_close(h, out["h"])
+
+
+def test_parameter_count_is_the_authors():
+    assert count_parameters(PGAE(ModelConfig(cell="peephole"))) == 657_778
+    assert ModelConfig().state_dim == 400
+
+
+def test_fused_parameter_count():
+    """nn.LSTM has two bias vectors and no peepholes: 4·H extra − 3·H per layer."""
+    per_layer = 100                                                # 4H − 3H
+    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer
+
+
+@pytest.mark.parametrize("cell", ["lstm", "peephole"])
+def test_teacher_forced_and_free_running_agree_at_step_0(toy_tensors, cell):
+    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    b = _batch(toy_tensors)
+    with torch.no_grad():
+        free = model(b)
+        forced = model(b, teacher_language=True, teacher_joints=True)
+    torch.testing.assert_close(forced["logits"][:, 0], free["logits"][:, 0])
+    torch.testing.assert_close(forced["joints"][:, 0], free["joints"][:, 0])
+    torch.testing.assert_close(forced["h"], free["h"])
+    # Later steps differ (an untrained model does not predict the recorded joints).
+    assert not torch.allclose(forced["joints"][:, 1:], free["joints"][:, 1:])
+
+
+@pytest.mark.parametrize("cell", ["lstm", "peephole"])
+def test_free_running_action_decoder_uses_its_own_predictions(toy_tensors, cell):
+    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    b = _batch(toy_tensors)
+    changed = _batch(toy_tensors)
+    changed.joint_target = changed.joint_target + 0.5
+    with torch.no_grad():
+        free, free_changed = model(b)["joints"], model(changed)["joints"]
+        forced, forced_changed = (model(b, teacher_joints=True)["joints"],
+                                  model(changed, teacher_joints=True)["joints"])
+    assert torch.equal(free, free_changed)
+    assert not torch.allclose(forced[:, 1:], forced_changed[:, 1:])
+    torch.testing.assert_close(forced[:, 0], forced_changed[:, 0])        # step 0 sees only the start joints
+
+
+@pytest.mark.parametrize("cell", ["lstm", "peephole"])
+def test_language_decoder_modes(toy_tensors, cell):
+    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    b = _batch(toy_tensors)
+    with torch.no_grad():
+        h, _ = model.encode(b)
+        greedy = model.language_decoder(h)
+        soft = model.language_decoder(h, feedback="soft")
+        # Greedy free-running = teacher forcing on its own argmax words.
+        forced_own = model.language_decoder(h, target=greedy.argmax(-1))
+    torch.testing.assert_close(forced_own, greedy, atol=1e-5, rtol=1e-5)
+    torch.testing.assert_close(soft[:, 0], greedy[:, 0])
+    assert greedy.shape == soft.shape == (4, 4, 23)
+
+
+def test_gradients_reach_every_module(toy_tensors):
+    model = PGAE(ModelConfig(units=16))
+    out = model(_batch(toy_tensors), teacher_language=True, teacher_joints=True)
+    (out["logits"].sum() + out["joints"].sum()).backward()
+    missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
+    assert not missing

@@ -1,0 +1,225 @@
+"""pgae_lite.train and pgae_lite.config: learning, determinism, checkpoints, resuming, profiles."""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+
+from pgae_lite.config import PROFILE_ENV, PROFILES, Profile, TrainConfig, get_profile
+from pgae_lite.data import Normaliser
+from pgae_lite.evaluate import predict
+from pgae_lite.pgae import ModelConfig
+from pgae_lite.train import CHECKPOINT, load_checkpoint, load_model, lr_factor, pgae_loss, train
+
+
+def tiny_profile(units: int = 16, **train) -> Profile:
+    """12 training samples, batches of 4, a few epochs: a second or two of training."""
+    cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1)
+    return Profile("tiny", ModelConfig(units=units), replace(cfg, **train))
+
+
+def _weights(model):
+    return {k: v.detach().clone() for k, v in model.state_dict().items()}
+
+
+def _same_weights(a, b) -> bool:
+    return a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+
+
+# --------------------------------------------------------------------------- learning
+def test_learns_a_handful_of_samples(toy_short):
+    """12 samples: the loss falls, joints are fitted, and <EOS> is learnt for execute / repeat action.
+
+    (Generating their descriptions 100% right takes thousands of optimiser steps with the current
+    recipe, far more than a unit test may spend, so description accuracy is not asserted here.)
+    """
+    prof = tiny_profile(units=32, epochs=40, lr=1e-2)
+    trained = train(toy_short, prof, progress=False, device="cpu")
+    h = trained.history
+    assert len(h) == 40 and [r["epoch"] for r in h] == list(range(1, 41))
+    first = h[0]
+    # Each epoch draws new signals for its 12 samples, so single epochs are noisy: average the last 5.
+    assert np.mean([r["loss"] for r in h[-5:]]) < 0.7 * first["loss"]
+    assert np.mean([r["action_loss"] for r in h[-5:]]) < 0.4 * first["action_loss"]
+    samples = toy_short.split("train").subset(slice(0, 12))
+    for signal in ("execute", "repeat action"):
+        assert predict(trained.model, samples, trained.normaliser, signal).correct.all(), signal
+    assert not trained.model.training
+    assert trained.seconds > 0
+
+
+def test_normaliser_from_training_samples_only(toy_short):
+    trained = train(toy_short, tiny_profile(epochs=1), progress=False, device="cpu")
+    assert trained.normaliser == Normaliser.fit(toy_short.split("train").subset(slice(0, 12)))
+
+
+def test_history_records(toy_short):
+    trained = train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu")
+    rec = trained.history[-1]
+    assert set(rec) >= {"epoch", "loss", "language_loss", "action_loss", "lr", "gate"}
+    assert rec["loss"] == pytest.approx(rec["language_loss"] + rec["action_loss"], rel=1e-5)
+    assert set(rec["gate"]) <= {"describe", "execute", "repeat action", "repeat both", "repeat language"}
+    assert all(0 < g < 1 for g in rec["gate"].values())
+
+
+# --------------------------------------------------------------------------- determinism
+def test_same_seed_same_run_different_seed_different_run(toy_short):
+    a = train(toy_short, tiny_profile(epochs=3), progress=False, device="cpu")
+    b = train(toy_short, tiny_profile(epochs=3), progress=False, device="cpu")
+    c = train(toy_short, tiny_profile(epochs=3, seed=1), progress=False, device="cpu")
+    assert a.history == b.history
+    assert _same_weights(_weights(a.model), _weights(b.model))
+    assert a.history != c.history
+    assert not _same_weights(_weights(a.model), _weights(c.model))
+
+
+# --------------------------------------------------------------------------- checkpoints
+def test_checkpoint_round_trip(toy_short, tmp_path):
+    prof = tiny_profile(epochs=2)
+    trained = train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu")
+    assert (tmp_path / CHECKPOINT).is_file()
+    assert not list(tmp_path.glob("*.tmp"))
+    model, norm, ckpt = load_model(tmp_path / CHECKPOINT, device="cpu")
+    assert not model.training
+    assert norm == trained.normaliser
+    assert ckpt["epoch"] == 2 and ckpt["history"] == trained.history and ckpt["profile"] == prof.to_dict()
+    assert _same_weights(_weights(model), _weights(trained.model))
+    test = toy_short.split("test").subset(slice(0, 8))
+    for signal in ("describe", "execute"):
+        p, q = predict(trained.model, test, trained.normaliser, signal), predict(model, test, norm, signal)
+        assert p.text == q.text
+        np.testing.assert_array_equal(p.joints, q.joints)
+
+
+def test_finished_run_returns_at_once(toy_short, tmp_path):
+    prof = tiny_profile(epochs=2)
+    first = train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu")
+    calls = []
+    again = train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu",
+                  callback=lambda *a: calls.append(a))
+    assert calls == []                                            # no epoch was run again
+    assert again.history == first.history
+    assert _same_weights(_weights(again.model), _weights(first.model))
+
+
+class Interrupt(Exception):
+    pass
+
+
+def test_resume_after_interruption_is_identical(toy_short, tmp_path):
+    """Stopping at epoch 3 of 5 (no checkpoint for it) and training again gives the same run."""
+    prof = tiny_profile(epochs=5)
+    whole = train(toy_short, prof, out_dir=tmp_path / "whole", progress=False, device="cpu")
+
+    def stop_at_3(epoch, model, record):
+        if epoch == 3:
+            raise Interrupt
+    with pytest.raises(Interrupt):
+        train(toy_short, prof, out_dir=tmp_path / "cut", progress=False, device="cpu", callback=stop_at_3)
+    assert load_checkpoint(tmp_path / "cut" / CHECKPOINT)["epoch"] == 2
+    epochs_run = []
+    resumed = train(toy_short, prof, out_dir=tmp_path / "cut", progress=False, device="cpu",
+                    callback=lambda epoch, *_: epochs_run.append(epoch))
+    assert epochs_run == [3, 4, 5]
+    assert resumed.history == whole.history
+    assert _same_weights(_weights(resumed.model), _weights(whole.model))
+
+
+def test_resume_with_sparse_checkpoints(toy_short, tmp_path):
+    """checkpoint_every=2: an interruption at epoch 4 resumes from epoch 2."""
+    prof = tiny_profile(epochs=5, checkpoint_every=2)
+    whole = train(toy_short, prof, progress=False, device="cpu")
+
+    def stop_at_4(epoch, model, record):
+        if epoch == 4:
+            raise Interrupt
+    with pytest.raises(Interrupt):
+        train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu", callback=stop_at_4)
+    assert load_checkpoint(tmp_path / CHECKPOINT)["epoch"] == 2
+    resumed = train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu")
+    assert resumed.history == whole.history
+    assert _same_weights(_weights(resumed.model), _weights(whole.model))
+
+
+def test_checkpoint_of_another_profile_is_refused(toy_short, tmp_path):
+    train(toy_short, tiny_profile(epochs=1), out_dir=tmp_path, progress=False, device="cpu")
+    with pytest.raises(ValueError, match="different profile"):
+        train(toy_short, tiny_profile(epochs=1, seed=7), out_dir=tmp_path, progress=False, device="cpu")
+
+
+def test_load_checkpoint_is_weights_only(tmp_path):
+    path = tmp_path / "evil.pt"
+    torch.save({"model": {}, "payload": os.system}, path)         # an arbitrary pickled object
+    with pytest.raises(Exception, match="(?i)weights.only"):
+        load_checkpoint(path)
+
+
+# --------------------------------------------------------------------------- loss
+def test_pgae_loss_by_hand(toy_tensors):
+    from pgae_lite.language import word_weights
+    from pgae_lite.signals import make_batch, signal_ids
+    b = make_batch(toy_tensors, torch.tensor([72, 0]), signal_ids(["describe", "execute"]), torch.tensor([0, 0]))
+    torch.manual_seed(0)
+    out = {"logits": torch.randn(2, 4, 23), "joints": torch.randn(2, 99, 5)}
+    w = word_weights()
+    total, lang, act = pgae_loss(out, b, w, alpha=2.0, beta=3.0)
+    logp = out["logits"].log_softmax(-1)
+    terms = [(w[b.lang_target[i, t]] * -logp[i, t, b.lang_target[i, t]])
+             for i in range(2) for t in range(4) if b.lang_mask[i, t]]
+    assert len(terms) == 5                                          # 4 words of describe, <EOS> of execute
+    assert float(lang) == pytest.approx(float(sum(terms) / 5), rel=1e-5)
+    sq = [((out["joints"][i, t] - b.joint_target[i, t]) ** 2).mean() for i in range(2) for t in range(99)
+          if b.joint_mask[i, t]]
+    assert len(sq) == 49 + 99
+    assert float(act) == pytest.approx(float(sum(sq) / len(sq)), rel=1e-5)
+    assert float(total) == pytest.approx(2 * float(lang) + 3 * float(act), rel=1e-5)
+
+
+# --------------------------------------------------------------------------- profiles
+def test_profiles():
+    assert set(PROFILES) == {"smoke", "book", "paper"}
+    paper = get_profile("paper")
+    assert paper.model.cell == "peephole" and paper.train.lr == 1e-5 and paper.train.batch_size == 6
+    assert paper.train.epochs == 6000 and not paper.train.signals_per_sample
+    p = get_profile("smoke", seed=3, epochs=7)
+    assert p.train.seed == 3 and p.train.epochs == 7
+    assert PROFILES["smoke"].train.seed == 0 and PROFILES["smoke"].train.epochs == 3   # built-ins untouched
+    assert p.to_dict()["model"]["units"] == 32
+
+
+def test_profile_from_environment(monkeypatch):
+    monkeypatch.setenv(PROFILE_ENV, "smoke")
+    assert get_profile().name == "smoke"
+    monkeypatch.delenv(PROFILE_ENV)
+    assert get_profile().name == "book"
+
+
+def test_unknown_profile_and_option():
+    with pytest.raises(ValueError) as e:
+        get_profile("fast")
+    assert "'fast'" in str(e.value) and all(n in str(e.value) for n in ("smoke", "book", "paper"))
+    with pytest.raises(ValueError) as e:
+        get_profile("smoke", learning_rate=1.0)
+    assert "learning_rate" in str(e.value)
+    for name in ("lr", "epochs", "batch_size", "seed"):
+        assert name in str(e.value)
+
+
+def test_lr_factor_warmup_then_cosine():
+    total, warmup = 1000, 0.1
+    f = [lr_factor(s, total, warmup, "cosine") for s in range(total)]
+    assert f[0] == pytest.approx(1 / 100) and f[49] == pytest.approx(0.5) and f[99] == pytest.approx(1.0)
+    assert all(b > a for a, b in zip(f[:99], f[1:100]))            # linear warm-up
+    assert f[100] == pytest.approx(1.0)
+    assert all(b <= a for a, b in zip(f[100:], f[101:]))           # then decreasing
+    assert f[550] == pytest.approx(0.5, abs=1e-9)                  # half-way down the cosine
+    assert f[325] == pytest.approx(0.5 * (1 + math.cos(math.pi * 0.25)))
+    assert 0 <= f[-1] < 1e-4
+    assert lr_factor(total + 5, total, warmup, "cosine") == 0.0     # past the end: 0, not rising again
+    assert [lr_factor(s, total, warmup, "constant") for s in (0, 99, 100, 999)] == \
+        pytest.approx([0.01, 1.0, 1.0, 1.0])
+    assert lr_factor(0, total, 0.0, "cosine") == 1.0                 # no warm-up
