@@ -35,7 +35,7 @@ def cb(epoch, model, rec):
     from pgae_lite.data import Normaliser
     res, _ = evaluate(model, ds, Normaliser.fit(ds.split("train")))
     line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
-            **{k[:6] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
+            **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
             "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}
     rows.append(line)
     print(json.dumps(line), flush=True)

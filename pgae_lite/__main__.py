@@ -14,13 +14,8 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
-from .config import PROFILE_ENV, PROFILES, get_profile
-from .data import DataFormatError, load_original
-from .evaluate import PAPER_TABLE, evaluate, format_table
-from .train import default_device, train
-
+PROFILE_NAMES = ("smoke", "book", "paper")  # pgae_lite.config.PROFILES (not imported: --help stays instant)
+PROFILE_ENV = "PGAE_LITE_PROFILE"
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 
 
@@ -28,11 +23,18 @@ def reproduce(original_data: str | Path, profile: str | None = None, seed: int =
               out_dir: str | Path | None = None, epochs: int | None = None,
               device: str | None = None, progress: bool = True) -> dict:
     """Train (or resume) and evaluate; write results.json and predictions.npz; return the results."""
+    import numpy as np
+
+    from .config import get_profile
+    from .data import load_original
+    from .evaluate import PAPER_TABLE, evaluate, format_table
+    from .train import train
+
     overrides = {"seed": seed} | ({"epochs": epochs} if epochs else {})
     prof = get_profile(profile, **overrides)
+    dataset = load_original(original_data)
     out = Path(out_dir or f"runs/original-{prof.name}-seed{seed}")
     out.mkdir(parents=True, exist_ok=True)
-    dataset = load_original(original_data)
     t0 = time.perf_counter()
     trained = train(dataset, prof, out_dir=out, device=device, progress=progress)
     results, preds = evaluate(trained.model, dataset, trained.normaliser)
@@ -70,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
     rep.add_argument("--original-data", metavar="PATH", default=os.environ.get(ORIGINAL_DATA_ENV),
                      help="the authors' data folder (holding target/ and actions.txt); "
                           f"default: ${ORIGINAL_DATA_ENV}")
-    rep.add_argument("--profile", choices=list(PROFILES), default=None,
+    rep.add_argument("--profile", choices=PROFILE_NAMES, default=None,
                      help=f"training recipe (default: ${PROFILE_ENV}, else 'book')")
     rep.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same numbers")
     rep.add_argument("--epochs", type=int, default=None, help="override the profile's number of epochs")
@@ -84,10 +86,13 @@ def main(argv: list[str] | None = None) -> int:
         if not args.original_data:
             parser.error("--original-data PATH is required (the authors' data folder from the public "
                          f"repository oo222bs/PGAE, or set ${ORIGINAL_DATA_ENV}); simulated data comes in a later version")
+        from .data import DataFormatError
+        from .train import CheckpointMismatchError
+
         try:
             reproduce(args.original_data, args.profile, args.seed, args.out, args.epochs,
-                      args.device or str(default_device()), not args.no_progress)
-        except (DataFormatError, ValueError) as e:
+                      args.device, not args.no_progress)
+        except (DataFormatError, CheckpointMismatchError) as e:
             print(f"error: {e}", file=sys.stderr)
             return 2
     return 0

@@ -29,6 +29,10 @@ from .signals import SignalBatch, make_batch, sample_signals
 CHECKPOINT = "checkpoint.pt"
 
 
+class CheckpointMismatchError(ValueError):
+    """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
+
+
 def default_device() -> torch.device:
     """CUDA when present, else the CPU."""
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
@@ -105,8 +109,9 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     if ckpt_path and ckpt_path.exists():
         ckpt = load_checkpoint(ckpt_path)
         if ckpt["profile"] != profile.to_dict():
-            raise ValueError(f"{ckpt_path} was trained with a different profile; use another output "
-                             "folder or delete the checkpoint to start again")
+            raise CheckpointMismatchError(
+                f"{ckpt_path} was trained with a different profile or seed; use another output "
+                "folder, or delete the checkpoint to start again")
         model.load_state_dict(ckpt["model"])
         optimiser.load_state_dict(ckpt["optimiser"])
         gen.set_state(ckpt["generator"])
@@ -190,5 +195,5 @@ def load_model(path: str | Path, device: torch.device | str | None = None) -> tu
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["train", "pgae_loss", "Trained", "load_model", "load_checkpoint", "save_checkpoint",
+__all__ = ["train", "pgae_loss", "CheckpointMismatchError", "Trained", "load_model", "load_checkpoint", "save_checkpoint",
            "default_device", "lr_factor", "asdict"]

@@ -99,7 +99,7 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
     # A second run in the same folder finds the finished checkpoint: no training, same results.
     # (In this process, with the already-loaded data, to keep the suite fast: same code path.)
     monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
-    monkeypatch.setattr(cli, "load_original", lambda path: original)
+    monkeypatch.setattr("pgae_lite.data.load_original", lambda path: original)
     assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--no-progress",
                  "--device", "cpu"]) == 0
     assert (out / "checkpoint.pt").read_bytes() == checkpoint           # no epoch was run again
@@ -113,3 +113,10 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
                  "--no-progress", "--device", "cpu"]) == 2
     assert "different profile" in capsys.readouterr().err
 
+
+
+def test_cli_profile_names_match_the_package():
+    from pgae_lite.__main__ import PROFILE_NAMES
+    from pgae_lite.config import PROFILES
+
+    assert tuple(PROFILES) == PROFILE_NAMES

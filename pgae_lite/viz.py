@@ -1,0 +1,182 @@
+"""Plots and tables for the book's chapters (matplotlib and pandas).
+
+Every function returns its figure (or DataFrame) and shows nothing itself:
+a notebook displays what a cell returns, a script may save it. Nothing here
+changes the model or the data.
+"""
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+import torch
+from matplotlib.figure import Figure
+
+from .data import PGAEDataset, description_text
+from .language import SIGNALS, VOCABULARY
+from .signals import SignalBatch
+
+#: One colour per signal, the same in every figure of the book.
+SIGNAL_COLOURS: dict[str, str] = {
+    "describe": "tab:blue", "execute": "tab:orange", "repeat action": "tab:green",
+    "repeat both": "tab:purple", "repeat language": "tab:red"}
+JOINT_NAMES: tuple[str, ...] = tuple(f"joint {k}" for k in range(1, 6))
+
+
+def _numpy(x) -> np.ndarray:
+    return x.detach().cpu().numpy() if isinstance(x, torch.Tensor) else np.asarray(x)
+
+
+def plot_gates(gates_by_signal: Mapping[str, np.ndarray | torch.Tensor], title: str = "GMU gate z") -> Figure:
+    """Mean GMU gate per signal (bars, ± one standard deviation) and per dimension (heat map).
+
+    ``gates_by_signal`` maps a signal name to gate values of shape (N, hidden),
+    e.g. ``{s: p.gate for s, p in predictions.items()}`` from
+    :func:`pgae_lite.evaluate.evaluate`. z near 1 lets the action features
+    through, z near 0 the language features (h = z ⊙ A_h + (1 − z) ⊙ L_h).
+    """
+    names = list(gates_by_signal)
+    gates = [_numpy(gates_by_signal[s]).reshape(-1, _numpy(gates_by_signal[s]).shape[-1]) for s in names]
+    fig, (bars, heat) = plt.subplots(1, 2, figsize=(11, 0.5 * len(names) + 2.2),
+                                     gridspec_kw={"width_ratios": [1, 2.2]})
+    means = [g.mean() for g in gates]
+    stds = [g.mean(1).std() for g in gates]                     # spread over samples
+    y = np.arange(len(names))
+    bars.barh(y, means, xerr=stds, color=[SIGNAL_COLOURS.get(s, "grey") for s in names])
+    bars.axvline(0.5, color="black", lw=0.8, ls=":")
+    bars.set(yticks=y, yticklabels=names, xlim=(0, 1), xlabel="mean z (0 = language, 1 = action)")
+    bars.invert_yaxis()
+    per_dim = np.stack([g.mean(0) for g in gates])              # (signals, hidden)
+    im = heat.imshow(per_dim, aspect="auto", cmap="coolwarm", vmin=0, vmax=1, interpolation="nearest")
+    heat.set(yticks=y, yticklabels=names, xlabel="dimension of h")
+    fig.colorbar(im, ax=heat, label="mean z")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_joints(pred: np.ndarray | torch.Tensor, target: np.ndarray | torch.Tensor,
+                length: int | None = None, title: str = "", ax: plt.Axes | None = None) -> Figure:
+    """The 5 joint angles over time: recorded (solid) and predicted (dashed).
+
+    ``pred`` and ``target`` have shape (T, 5); steps at or past ``length`` (or
+    NaN) are not drawn.
+    """
+    pred, target = _numpy(pred), _numpy(target)
+    length = length or len(target)
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6, 3.2))
+    else:
+        fig = ax.figure
+    steps = np.arange(length)
+    for k in range(target.shape[1]):
+        colour = f"C{k}"
+        ax.plot(steps, target[:length, k], color=colour, lw=2, alpha=0.5, label=JOINT_NAMES[k])
+        ax.plot(steps, pred[:length, k], color=colour, lw=1.2, ls="--")
+    ax.plot([], [], color="grey", lw=2, alpha=0.5, label="recorded")
+    ax.plot([], [], color="grey", lw=1.2, ls="--", label="predicted")
+    ax.set(xlabel="time step", ylabel="joint value", title=title)
+    ax.legend(fontsize="small", ncol=2, loc="best")
+    fig.tight_layout()
+    return fig
+
+
+def plot_history(history: Sequence[Mapping]) -> Figure:
+    """Training curves from ``Trained.history``: losses (log scale) and the mean gate per signal."""
+    epochs = [r["epoch"] for r in history]
+    fig, (loss_ax, gate_ax) = plt.subplots(1, 2, figsize=(11, 3.6))
+    for key, label in (("loss", "total"), ("language_loss", "language (weighted CE)"),
+                       ("action_loss", "action (MSE)")):
+        loss_ax.plot(epochs, [r[key] for r in history], label=label, marker="." if len(epochs) < 10 else None)
+    loss_ax.set(yscale="log", xlabel="epoch", ylabel="training loss", title="Loss")
+    loss_ax.legend()
+    for s in SIGNALS:
+        points = [(r["epoch"], r["gate"][s]) for r in history if s in r["gate"]]
+        if points:
+            x, z = zip(*points)
+            gate_ax.plot(x, z, label=s, color=SIGNAL_COLOURS[s], marker="." if len(x) < 10 else None)
+    gate_ax.axhline(0.5, color="black", lw=0.8, ls=":")
+    gate_ax.set(ylim=(0, 1), xlabel="epoch", ylabel="mean z", title="Mean GMU gate per signal (training)")
+    gate_ax.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def _words(tokens: Sequence[int]) -> str:
+    """Token indices of the 28-d input space -> text; signal tokens in brackets."""
+    out = []
+    for t in tokens:
+        t = int(t)
+        out.append(f"[{SIGNALS[t - len(VOCABULARY)]}]" if t >= len(VOCABULARY) else VOCABULARY[t])
+    return " ".join(out)
+
+
+def signal_table(batch: SignalBatch) -> pd.DataFrame:
+    """One row per sample of ``batch``: what goes into the encoders and what the decoders must produce.
+
+    Build ``batch`` with :func:`pgae_lite.signals.make_batch`, e.g. one sample
+    under each of the five signals, to get the paper's "Signals" list as a table.
+    """
+    rows = []
+    for i in range(len(batch.signal)):
+        n_lang, n_act = int(batch.lang_lengths[i]), int(batch.action_lengths[i])
+        steps = int(batch.joint_mask[i].sum()) + 1              # recorded steps of the sample
+        target = batch.joint_target[i, :steps - 1]              # (steps-1, 5)
+        held = bool(torch.allclose(target, batch.start_joints[i].expand_as(target)))
+        first = batch.action_input[i, 0, -batch.start_joints.shape[1]:]
+        if held:
+            pose = "first" if torch.allclose(batch.start_joints[i], first) else "final"
+            action_out = f"{pose} pose, held for {steps} steps"
+        else:
+            action_out = f"recorded sequence, {steps} steps"
+        lang_out = _words(batch.lang_target[i][batch.lang_mask[i]].tolist()).replace(VOCABULARY[0], "<EOS>")
+        rows.append({
+            "signal": SIGNALS[int(batch.signal[i])],
+            "language input": _words(batch.lang_tokens[i, :n_lang].tolist()).replace(VOCABULARY[0], "<EOS>"),
+            "action input": f"whole sequence ({n_act} steps)" if n_act > 1 else "first step only",
+            "language target": lang_out,
+            "action target": action_out,
+        })
+    return pd.DataFrame(rows).set_index("signal")
+
+
+def prediction_frame(pred, data: PGAEDataset) -> pd.DataFrame:
+    """One row per sample of a :class:`pgae_lite.evaluate.Predictions` on ``data`` (same order).
+
+    Columns: id, code (the authors' label, e.g. ``PUSH-L-SLOW``), action, side,
+    speed, arrangement, expected (first of the 8 descriptions), generated and
+    correct. Group it for an error analysis, e.g.
+    ``frame.groupby("action").correct.mean()``.
+    """
+    code = pd.Series(np.asarray(data.action), dtype=str)
+    parts = code.str.split("-")
+    return pd.DataFrame({
+        "id": np.asarray(data.ids),
+        "code": code,
+        "action": parts.str[0].str.lower(),
+        "side": parts.str[1].map({"L": "left cube", "R": "right cube"}),
+        "speed": parts.str[2].str.lower(),
+        "arrangement": np.asarray(data.arrangement),
+        "expected": [description_text(d[0]) for d in data.descriptions],
+        "generated": list(pred.text),
+        "correct": np.asarray(pred.correct, dtype=bool),
+    })
+
+
+def plot_vision(features: np.ndarray | torch.Tensor, length: int | None = None, title: str = "") -> Figure:
+    """The 30 visual features of one sample over time as an image (10 per colour channel)."""
+    features = _numpy(features)[:length or None]                 # (T, 30)
+    fig, ax = plt.subplots(figsize=(7, 2.8))
+    im = ax.imshow(features.T, aspect="auto", cmap="viridis", interpolation="nearest")
+    for edge in (9.5, 19.5):                                     # R | G | B channel blocks
+        ax.axhline(edge, color="white", lw=1)
+    ax.set(xlabel="time step", ylabel="feature (R, G, B blocks)", title=title)
+    fig.colorbar(im, ax=ax)
+    fig.tight_layout()
+    return fig
+
+
+__all__ = ["plot_gates", "plot_joints", "plot_history", "signal_table", "prediction_frame", "plot_vision",
+           "SIGNAL_COLOURS"]
