@@ -23,7 +23,7 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 class TrainConfig:
     """How PGAE is trained. Defaults are the ``book`` recipe."""
 
-    epochs: int = 300
+    epochs: int = 400
     batch_size: int = 64
     # Deviation from paper: Adam 2e-3 with warm-up and cosine decay (paper: 1e-5, constant).
     lr: float = 2e-3

@@ -13,9 +13,10 @@ import numpy as np
 import pandas as pd
 import torch
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from .data import PGAEDataset, description_text
-from .language import SIGNALS, VOCABULARY
+from .language import CANONICAL, SIGNALS, SLOT_NAMES, VOCABULARY
 from .signals import SignalBatch
 
 #: One colour per signal, the same in every figure of the book.
@@ -100,6 +101,8 @@ def plot_history(history: Sequence[Mapping]) -> Figure:
     gate_ax.axhline(0.5, color="black", lw=0.8, ls=":")
     gate_ax.set(ylim=(0, 1), xlabel="epoch", ylabel="mean z", title="Mean GMU gate per signal (training)")
     gate_ax.legend(fontsize="small")
+    for ax in (loss_ax, gate_ax):
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     fig.tight_layout()
     return fig
 
@@ -142,16 +145,30 @@ def signal_table(batch: SignalBatch) -> pd.DataFrame:
     return pd.DataFrame(rows).set_index("signal")
 
 
+def wrong_words(expected: str, generated: str) -> str:
+    """Which of action / colour / speed differ ("" when none; synonyms count as equal).
+
+    A generated text of another length than the expected one gives e.g. ``"2 words"``.
+    """
+    e, g = expected.split(), generated.split()
+    if len(g) != len(e):
+        return f"{len(g)} word{'s' * (len(g) != 1)}" if g else "<EOS> only"
+    return ", ".join(n for n, a, b in zip(SLOT_NAMES, e, g) if CANONICAL[a] != CANONICAL.get(b))
+
+
 def prediction_frame(pred, data: PGAEDataset) -> pd.DataFrame:
     """One row per sample of a :class:`pgae_lite.evaluate.Predictions` on ``data`` (same order).
 
     Columns: id, code (the authors' label, e.g. ``PUSH-L-SLOW``), action, side,
-    speed, arrangement, expected (first of the 8 descriptions), generated and
-    correct. Group it for an error analysis, e.g.
-    ``frame.groupby("action").correct.mean()``.
+    speed, arrangement, expected (the first of the 8 descriptions, or "" where
+    the signal expects ``<EOS>`` alone), generated, correct, and wrong (which
+    words of a wrong description are wrong). Group it for an error analysis,
+    e.g. ``frame.groupby("action").correct.mean()``.
     """
     code = pd.Series(np.asarray(data.action), dtype=str)
     parts = code.str.split("-")
+    says_words = pred.signal in ("describe", "repeat language", "repeat both")
+    expected = [description_text(d[0]) if says_words else "" for d in data.descriptions]
     return pd.DataFrame({
         "id": np.asarray(data.ids),
         "code": code,
@@ -159,9 +176,10 @@ def prediction_frame(pred, data: PGAEDataset) -> pd.DataFrame:
         "side": parts.str[1].map({"L": "left cube", "R": "right cube"}),
         "speed": parts.str[2].str.lower(),
         "arrangement": np.asarray(data.arrangement),
-        "expected": [description_text(d[0]) for d in data.descriptions],
+        "expected": expected,
         "generated": list(pred.text),
         "correct": np.asarray(pred.correct, dtype=bool),
+        "wrong": ["" if ok else wrong_words(e, g) for ok, e, g in zip(pred.correct, expected, pred.text)],
     })
 
 
@@ -178,5 +196,5 @@ def plot_vision(features: np.ndarray | torch.Tensor, length: int | None = None, 
     return fig
 
 
-__all__ = ["plot_gates", "plot_joints", "plot_history", "signal_table", "prediction_frame", "plot_vision",
+__all__ = ["plot_gates", "plot_joints", "plot_history", "signal_table", "prediction_frame", "wrong_words", "plot_vision",
            "SIGNAL_COLOURS"]

@@ -11,7 +11,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import pgae_lite.__main__ as cli
 from pgae_lite.__main__ import main
 from pgae_lite.language import TEST_SIGNALS
 
