@@ -34,8 +34,6 @@ class ModelConfig:
     layers: int = 2
     hidden: int = 50
     cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
-    # "absolute": ĵ_{t+1} = tanh(W y_t + b), the paper's; "delta": ĵ_{t+1} = ĵ_t + W y_t + b
-    joint_output: str = "absolute"
 
     @property
     def state_dim(self) -> int:
@@ -127,16 +125,9 @@ class ActionDecoder(nn.Module):
     def __init__(self, cfg: ModelConfig):
         super().__init__()
         self.layers = cfg.layers
-        if cfg.joint_output not in ("absolute", "delta"):
-            raise ValueError(f"unknown joint_output {cfg.joint_output!r}; the options are: absolute, delta")
-        self.delta = cfg.joint_output == "delta"
         self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)
         self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
         self.out = nn.Linear(cfg.units, JOINT_DIM)
-
-    def next_joints(self, y: torch.Tensor, prev: torch.Tensor) -> torch.Tensor:
-        """ĵ_{t+1} from the LSTM output y_t and the input joints ĵ_t."""
-        return prev + self.out(y) if self.delta else torch.tanh(self.out(y))
 
     def forward(self, h: torch.Tensor, vision: torch.Tensor, start: torch.Tensor,
                 teacher_joints: torch.Tensor | None = None) -> torch.Tensor:
@@ -145,11 +136,11 @@ class ActionDecoder(nn.Module):
         if teacher_joints is not None:                          # inputs ĵ_t := recorded j_t
             prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)   # (B, S, 5)
             y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
-            return self.next_joints(y, prev)
+            return torch.tanh(self.out(y))
         j, outs = start, []
         for v_t in vision.unbind(1):                            # S x (B, 30)
             y, state = self.rnn.step(torch.cat([v_t, j], 1), state)
-            j = self.next_joints(y, j)                          # ĵ_{t+1}
+            j = torch.tanh(self.out(y))                         # ĵ_{t+1}
             outs.append(j)
         return torch.stack(outs, 1)
 

@@ -88,24 +88,3 @@ def test_gradients_reach_every_module(toy_tensors):
     (out["logits"].sum() + out["joints"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
     assert not missing
-
-
-def test_delta_joint_output_adds_to_the_previous_joints():
-    import torch
-    from pgae_lite.pgae import ActionDecoder, ModelConfig
-
-    dec = ActionDecoder(ModelConfig(units=16, joint_output="delta"))
-    torch.nn.init.zeros_(dec.out.weight)
-    torch.nn.init.zeros_(dec.out.bias)
-    h, vision, start = torch.randn(3, 50), torch.randn(3, 9, 30), torch.rand(3, 5)
-    held = start[:, None].expand(3, 9, 5)
-    assert torch.allclose(dec(h, vision, start), held)                      # zero change: the pose is held
-    assert torch.allclose(dec(h, vision, start, teacher_joints=held), held)
-
-
-def test_unknown_joint_output_is_a_clear_error():
-    import pytest
-    from pgae_lite.pgae import PGAE, ModelConfig
-
-    with pytest.raises(ValueError, match="absolute, delta"):
-        PGAE(ModelConfig(joint_output="relative"))
