@@ -291,4 +291,4 @@ def description_text(indices: np.ndarray) -> str:
 
 
 __all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "load_original", "description_text",
-           "MAX_STEPS", "JOINT_DIM", "VISION_DIM", "WORD_INDEX"]
+           "MAX_STEPS", "JOINT_DIM", "VISION_DIM", "Pattern", "ARRANGEMENTS", "TEST_PATTERNS"]

@@ -51,12 +51,16 @@ class Predictions:
 
 @torch.no_grad()
 def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
-            opposite: bool = False, batch_size: int = 256) -> Predictions:
-    """Run ``model`` on every sample of ``data`` with one signal (decoders free-running)."""
+            opposite: bool = False, batch_size: int = 256,
+            tensors: dict[str, torch.Tensor] | None = None) -> Predictions:
+    """Run ``model`` on every sample of ``data`` with one signal (decoders free-running).
+
+    ``tensors``: ``normaliser.tensors(data, device)`` when the caller has them already.
+    """
     signal = normalise_signal(signal)
     model.eval()
     device = next(model.parameters()).device
-    tensors = normaliser.tensors(data, device)
+    tensors = tensors or normaliser.tensors(data, device)
     n = len(data)
     texts, joints, targets, gates = [], [], [], []
     for s in range(0, n, batch_size):
@@ -100,9 +104,10 @@ def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str 
     """
     joint_range = joint_range or data.joint_range()
     subset = data.split(split)
+    tensors = normaliser.tensors(subset, next(model.parameters()).device)
     results, preds = {}, {}
     for signal in TEST_SIGNALS:
-        p = predict(model, subset, normaliser, signal, opposite=opposite)
+        p = predict(model, subset, normaliser, signal, opposite=opposite, tensors=tensors)
         err, err_padded = nrmse(p, joint_range)
         results[signal] = {"accuracy": 100 * float(p.correct.mean()), "nrmse": err,
                            "nrmse_padded": err_padded, "n": int(len(p.correct))}

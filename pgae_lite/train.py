@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import os
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 import torch
@@ -196,4 +196,4 @@ def load_model(path: str | Path, device: torch.device | str | None = None) -> tu
 
 
 __all__ = ["train", "pgae_loss", "CheckpointMismatchError", "Trained", "load_model", "load_checkpoint", "save_checkpoint",
-           "default_device", "lr_factor", "asdict"]
+           "default_device", "lr_factor"]
