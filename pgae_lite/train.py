@@ -4,9 +4,10 @@
 
 The word weights counter word frequency (``<BOS/EOS>`` is in every
 description, a colour word in one of six); both terms are averaged over the
-valid steps only. Training is deterministic under a seed, runs on CUDA when
-present (else the CPU), and resumes from its last checkpoint after an
-interruption.
+valid steps only. Training is deterministic under a seed (bit for bit on the
+same device with the same number of torch threads: a 1-thread and a 2-thread
+CPU run round sums differently and drift apart), runs on CUDA when present
+(else the CPU), and resumes from its last checkpoint after an interruption.
 """
 from __future__ import annotations
 
