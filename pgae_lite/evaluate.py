@@ -19,9 +19,9 @@ import numpy as np
 import torch
 
 from .data import Normaliser, PGAEDataset
-from .language import TEST_SIGNALS, VOCABULARY, decode, normalise_signal
+from .language import SIGNALS, TEST_SIGNALS, VOCABULARY, decode, is_correct, normalise_signal
 from .pgae import PGAE
-from .signals import make_batch, signal_ids
+from .signals import LANG_OUT, make_batch, signal_ids
 
 #: The paper's Table 1: (accuracy %, nRMSE %) per row and signal.
 PAPER_TABLE: dict[str, dict[str, tuple[float, float]]] = {
@@ -77,10 +77,10 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
     mask = data.mask[..., None]
     joints_arr = np.where(mask, np.concatenate(joints), np.nan).astype(np.float32)
     target_arr = np.where(mask, np.concatenate(targets), np.nan).astype(np.float32)
-    expected_text = signal in ("describe", "repeat language", "repeat both")
+    expected_text = LANG_OUT[SIGNALS.index(signal)]
     correct = np.array([
-        (t in {" ".join(VOCABULARY[w] for w in alt) for alt in data.descriptions[i]}) if expected_text
-        else t == "" for i, t in enumerate(texts)])
+        is_correct(t, [tuple(VOCABULARY[w] for w in alt) for alt in data.descriptions[i]] if expected_text else None)
+        for i, t in enumerate(texts)])
     return Predictions(signal, np.asarray(data.ids), texts, joints_arr, target_arr, correct,
                        np.concatenate(gates))
 

@@ -25,7 +25,7 @@ from .config import Profile, get_profile
 from .data import Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .pgae import PGAE, ModelConfig
-from .signals import SignalBatch, make_batch, sample_signals
+from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
 
 CHECKPOINT = "checkpoint.pt"
 
@@ -138,7 +138,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             signal = sample_signals(size, gen, cfg.signals_per_sample)
             alternative = torch.randint(8, (size,), generator=gen)
             opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
-            opposite &= signal != 1  # execute shows no action to the encoder
+            opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
                         feedback="greedy" if cfg.teacher_language else "soft")
