@@ -38,6 +38,7 @@ class TrainConfig:
     # Deviation from paper: the action decoder gets the recorded joints for this
     # fraction of training, then its own predictions (authors: 0, always its own).
     teacher_joints_until: float = 0.75
+    joint_noise: float = 0.0            # std of noise on the recorded joints read under teacher forcing
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β

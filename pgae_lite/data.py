@@ -12,6 +12,7 @@ training split only.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -23,6 +24,10 @@ from .language import VOCABULARY, WORD_INDEX, equivalent_descriptions
 MAX_STEPS = 100
 JOINT_DIM = 5
 VISION_DIM = 30
+
+
+_ARRAYS = ("joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern",
+           "is_test", "ids", "action", "arrangement")
 
 
 @dataclass
@@ -60,9 +65,7 @@ class PGAEDataset:
 
     def subset(self, index: np.ndarray) -> "PGAEDataset":
         """The samples at ``index`` (a bool mask or integer indices)."""
-        arrays = {k: getattr(self, k)[index] for k in (
-            "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern",
-            "is_test", "ids", "action", "arrangement")}
+        arrays = {k: getattr(self, k)[index] for k in _ARRAYS}
         return PGAEDataset(**arrays, source=self.source, extras=self.extras)
 
     def split(self, name: str) -> "PGAEDataset":
@@ -75,6 +78,29 @@ class PGAEDataset:
         """Observed range (max - min) of joint values over valid steps: nRMSE's denominator."""
         valid = self.joints[self.mask]
         return float(valid.max() - valid.min())
+
+    def save(self, path: str | Path) -> None:
+        """Write every array to one ``.npz`` file, atomically (a temporary file, then a rename)."""
+        path = Path(path)
+        arrays = {k: getattr(self, k) for k in _ARRAYS}
+        tmp = path.with_name(path.name + ".tmp")
+        with open(tmp, "wb") as f:
+            np.savez_compressed(f, source=np.array(self.source), **arrays)
+        os.replace(tmp, path)
+
+    @classmethod
+    def load(cls, path: str | Path) -> "PGAEDataset":
+        """Read a file written by :meth:`save`; :class:`DataFormatError` if it is damaged."""
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                arrays = {k: f[k] for k in _ARRAYS}
+                source = str(f["source"])
+        except Exception as e:  # zip, zlib, missing keys: all mean a damaged or foreign file
+            raise DataFormatError(f"{path}: not a readable PGAE dataset file ({type(e).__name__}: {e})") from None
+        n = len(arrays["lengths"])
+        if any(len(a) != n for a in arrays.values()) or arrays["joints"].shape[1:] != (MAX_STEPS, JOINT_DIM):
+            raise DataFormatError(f"{path}: arrays of inconsistent shapes")
+        return cls(**arrays, source=source)
 
 
 @dataclass
@@ -175,6 +201,11 @@ class Pattern:
     @property
     def is_test(self) -> bool:
         return self.number in TEST_PATTERNS
+
+    @property
+    def steps(self) -> int:
+        """Length of a recording: 100 steps slowly, 50 fast."""
+        return MAX_STEPS if self.speed == "slowly" else MAX_STEPS // 2
 
     @property
     def code(self) -> str:

@@ -130,19 +130,37 @@ class ActionDecoder(nn.Module):
         self.out = nn.Linear(cfg.units, JOINT_DIM)
 
     def forward(self, h: torch.Tensor, vision: torch.Tensor, start: torch.Tensor,
-                teacher_joints: torch.Tensor | None = None) -> torch.Tensor:
-        """vision (B, S, 30), start (B, 5) -> joints of steps 1..S (B, S, 5)."""
+                teacher_joints: torch.Tensor | None = None, steps: torch.Tensor | None = None) -> torch.Tensor:
+        """vision (B, S, 30), start (B, 5) -> joints of steps 1..S (B, S, 5).
+
+        ``steps`` (B,), if given, is how many steps each sample needs: a free-running
+        decoder then stops computing a sample after its last step (outputs 0 there).
+        """
         state = vector_to_state(self.init_state(h), self.layers)
         if teacher_joints is not None:                          # inputs ĵ_t := recorded j_t
             prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)   # (B, S, 5)
             y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
             return torch.tanh(self.out(y))
-        j, outs = start, []
-        for v_t in vision.unbind(1):                            # S x (B, 30)
-            y, state = self.rnn.step(torch.cat([v_t, j], 1), state)
-            j = torch.tanh(self.out(y))                         # ĵ_{t+1}
-            outs.append(j)
-        return torch.stack(outs, 1)
+        B, S, _ = vision.shape
+        if steps is None:
+            steps = torch.full((B,), S, device=vision.device)
+        order = torch.argsort(steps.cpu(), descending=True, stable=True)      # longest first
+        active = (steps.cpu()[order][None] > torch.arange(S)[:, None]).sum(1).tolist()  # (S,) samples still running
+        order = order.to(vision.device)
+        vision, j = vision[order], start[order]
+        state = (state[0][:, order], state[1][:, order])
+        outs = []
+        for t, v_t in enumerate(vision.unbind(1)):              # S x (B, 30)
+            k = active[t]
+            if k == 0:
+                break
+            state = (state[0][:, :k], state[1][:, :k])
+            y, state = self.rnn.step(torch.cat([v_t[:k], j[:k]], 1), state)
+            j = torch.tanh(self.out(y))                         # ĵ_{t+1}, (k, 5)
+            outs.append(nn.functional.pad(j, (0, 0, 0, B - k)))
+        joints = torch.stack(outs, 1)                           # (B, S', 5), S' <= S
+        joints = nn.functional.pad(joints, (0, 0, 0, S - joints.shape[1]))
+        return torch.empty_like(joints).index_copy_(0, order, joints)   # back to the batch's order
 
 
 class PGAE(nn.Module):
@@ -164,13 +182,25 @@ class PGAE(nn.Module):
         return self.gmu(f_act, f_lang)
 
     def forward(self, batch: SignalBatch, teacher_language: bool = False,
-                teacher_joints: bool = False, feedback: str = "greedy") -> dict[str, torch.Tensor]:
-        """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden)."""
+                teacher_joints: bool = False, feedback: str = "greedy",
+                joint_noise: float = 0.0) -> dict[str, torch.Tensor]:
+        """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden).
+
+        With ``teacher_joints`` the action decoder reads the recorded joints, plus
+        Gaussian noise of standard deviation ``joint_noise`` (training only).
+        """
         h, z = self.encode(batch)
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
-        joints = self.action_decoder(
-            h, batch.dec_vision, batch.start_joints, batch.joint_target if teacher_joints else None)
+        teacher = None
+        if teacher_joints:
+            teacher = batch.joint_target
+            if joint_noise:
+                # Deviation from paper: noisy recorded joints teach the decoder to recover
+                # from its own small errors (it reads its own predictions at test time).
+                teacher = teacher + joint_noise * torch.randn_like(teacher)
+        joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, teacher,
+                                     steps=batch.joint_mask.sum(1))
         return {"logits": logits, "joints": joints, "h": h, "gate": z}
 
 

@@ -141,7 +141,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
-                        feedback="greedy" if cfg.teacher_language else "soft")
+                        feedback="greedy" if cfg.teacher_language else "soft", joint_noise=cfg.joint_noise)
             loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)
             optimiser.zero_grad(set_to_none=True)
             loss.backward()

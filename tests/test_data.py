@@ -308,3 +308,22 @@ def test_subset_and_mask(toy):
     assert int(toy.is_test.sum()) == 36
     assert all(np.array_equal(toy.descriptions[i], Pattern.from_number(int(toy.pattern[i])).descriptions())
                for i in range(len(toy)))
+
+
+def test_dataset_save_load_round_trip_and_damage(tmp_path):
+    from pgae_lite.data import DataFormatError, PGAEDataset
+    from pgae_lite.toydata import toy_dataset
+
+    ds = toy_dataset()
+    path = tmp_path / "ds.npz"
+    ds.save(path)
+    back = PGAEDataset.load(path)
+    for k in ("joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test", "ids",
+              "action", "arrangement"):
+        np.testing.assert_array_equal(getattr(back, k), getattr(ds, k))
+    assert back.source == ds.source
+    raw = bytearray(path.read_bytes())
+    raw[len(raw) // 2] ^= 0xFF                                       # one flipped byte
+    path.write_bytes(bytes(raw[: len(raw) - 100]))                  # ... and a truncated file
+    with pytest.raises(DataFormatError, match="not a readable PGAE dataset"):
+        PGAEDataset.load(path)

@@ -88,3 +88,32 @@ def test_gradients_reach_every_module(toy_tensors):
     (out["logits"].sum() + out["joints"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
     assert not missing
+
+
+@pytest.mark.parametrize("cell", ["lstm", "peephole"])
+def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, cell):
+    """Skipping finished samples changes nothing on valid steps, and leaves zeros past them."""
+    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    b = _batch(toy_tensors)
+    steps = b.joint_mask.sum(1)
+    assert len(set(steps.tolist())) == 2                            # a mix of fast and slow samples
+    with torch.no_grad():
+        h, _ = model.encode(b)
+        full = model.action_decoder(h, b.dec_vision, b.start_joints)
+        short = model.action_decoder(h, b.dec_vision, b.start_joints, steps=steps)
+    mask = b.joint_mask[..., None].expand_as(full)
+    torch.testing.assert_close(short[mask], full[mask])
+    assert (short[~mask] == 0).all()
+
+
+def test_joint_noise_only_changes_teacher_forced_inputs(toy_tensors):
+    torch.manual_seed(0)
+    model = PGAE(ModelConfig(units=16)).eval()
+    b = _batch(toy_tensors)
+    with torch.no_grad():
+        clean = model(b, teacher_joints=True)["joints"]
+        noisy = model(b, teacher_joints=True, joint_noise=0.1)["joints"]
+        free, free_noise = model(b)["joints"], model(b, joint_noise=0.1)["joints"]
+    torch.testing.assert_close(noisy[:, 0], clean[:, 0])           # step 0 reads the start joints
+    assert not torch.allclose(noisy[:, 1:], clean[:, 1:])
+    assert torch.equal(free, free_noise)                            # free-running: no teacher, no noise
