@@ -19,10 +19,14 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 
 
-def reproduce(original_data: str | Path, profile: str | None = None, seed: int = 0,
+def reproduce(original_data: str | Path | None = None, profile: str | None = None, seed: int = 0,
               out_dir: str | Path | None = None, epochs: int | None = None,
               device: str | None = None, progress: bool = True) -> dict:
-    """Train (or resume) and evaluate; write results.json and predictions.npz; return the results."""
+    """Train (or resume) and evaluate; write results.json and predictions.npz; return the results.
+
+    ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
+    our simulated data (simulator -> CAE -> PGAE, each step cached).
+    """
     import numpy as np
 
     from .config import get_profile
@@ -32,15 +36,19 @@ def reproduce(original_data: str | Path, profile: str | None = None, seed: int =
 
     overrides = {"seed": seed} | ({"epochs": epochs} if epochs else {})
     prof = get_profile(profile, **overrides)
-    dataset = load_original(original_data)
-    out = Path(out_dir or f"runs/original-{prof.name}-seed{seed}")
+    if original_data:
+        dataset, source = load_original(original_data), "original"
+    else:
+        from .pipeline import simulated_dataset
+        dataset, source = simulated_dataset(prof.name, device, progress), "simulated"
+    out = Path(out_dir or f"runs/{source}-{prof.name}-seed{seed}")
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     trained = train(dataset, prof, out_dir=out, device=device, progress=progress)
     results, preds = evaluate(trained.model, dataset, trained.normaliser)
     row = "PGAE (ours)"
     report = {
-        "row": "PGAE", "data": str(original_data), "profile": prof.to_dict(), "seed": seed,
+        "row": "PGAE", "data": str(original_data) if original_data else dataset.source, "profile": prof.to_dict(), "seed": seed,
         "device": str(next(trained.model.parameters()).device),
         "train_seconds": trained.seconds, "wall_seconds": time.perf_counter() - t0,
         "results": results, "paper": {s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE["PGAE"].items()},
@@ -62,6 +70,18 @@ def reproduce(original_data: str | Path, profile: str | None = None, seed: int =
     return report
 
 
+def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
+    """Record the profile's simulated dataset (or complete it) and print what was done."""
+    from .simdata import DATASET_PROFILES, generate
+
+    name = profile or os.environ.get(PROFILE_ENV, "book")
+    report = generate(DATASET_PROFILES[name], workers=workers, progress=progress)
+    print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
+          f"in {report.seconds:.1f} s, {report.corrupt} damaged files replaced; "
+          f"valid on the first try: {100 * report.first_try:.1f}%")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m pgae_lite", description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -71,21 +91,30 @@ def main(argv: list[str] | None = None) -> int:
                                      "evaluate it on the test split and print Table 1 beside the paper's row.")
     rep.add_argument("--original-data", metavar="PATH", default=os.environ.get(ORIGINAL_DATA_ENV),
                      help="the authors' data folder (holding target/ and actions.txt); "
-                          f"default: ${ORIGINAL_DATA_ENV}")
+                          f"default: ${ORIGINAL_DATA_ENV}; without either, our simulated data "
+                          "(recorded, CAE-encoded and cached on first use)")
     rep.add_argument("--profile", choices=PROFILE_NAMES, default=None,
                      help=f"training recipe (default: ${PROFILE_ENV}, else 'book')")
     rep.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same numbers")
     rep.add_argument("--epochs", type=int, default=None, help="override the profile's number of epochs")
     rep.add_argument("--out", metavar="DIR", default=None,
                      help="output folder for checkpoint.pt, results.json, predictions.npz "
-                          "(default: runs/original-PROFILE-seedSEED)")
+                          "(default: runs/original-PROFILE-seedSEED or runs/simulated-PROFILE-seedSEED)")
     rep.add_argument("--device", default=None, help="torch device, e.g. cpu or cuda (default: CUDA if present)")
     rep.add_argument("--no-progress", action="store_true", help="no progress bar")
+    sim = sub.add_parser("simulate", help="record the simulated dataset into the cache",
+                         description="Record every episode of the profile's dataset (144 patterns x 6 "
+                                     "variations in the book profile) with the pybullet simulator, in "
+                                     "parallel, into the cache ($PGAE_LITE_CACHE, else ~/.cache/pgae_lite). "
+                                     "Episodes already recorded are kept; an interrupted run resumes.")
+    sim.add_argument("--profile", choices=PROFILE_NAMES, default=None,
+                     help=f"dataset size (default: ${PROFILE_ENV}, else 'book')")
+    sim.add_argument("--workers", type=int, default=None, help="parallel processes (default: one per CPU core)")
+    sim.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    if args.command == "simulate":
+        return simulate(args.profile, args.workers, not args.no_progress)
     if args.command == "reproduce":
-        if not args.original_data:
-            parser.error("--original-data PATH is required (the authors' data folder from the public "
-                         f"repository oo222bs/PGAE, or set ${ORIGINAL_DATA_ENV}); simulated data comes in a later version")
         from .data import DataFormatError
         from .train import CheckpointMismatchError
 

@@ -18,6 +18,7 @@ from pgae_lite.data import Normaliser, load_original
 from pgae_lite.toydata import toy_dataset
 
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
+CACHE_ENV = "PGAE_LITE_CACHE"
 
 # Tiny models run no faster on two threads, and much slower when another job shares the cores.
 torch.set_num_threads(1)
@@ -70,6 +71,27 @@ def original_data() -> Path:
 def original(original_data):
     """The authors' dataset, loaded once per session (a few seconds)."""
     return load_original(original_data)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _private_cache(tmp_path_factory):
+    """Tests never read or write the user's cache: one empty cache folder per test session."""
+    old = os.environ.get(CACHE_ENV)
+    os.environ[CACHE_ENV] = str(tmp_path_factory.mktemp("cache"))
+    yield
+    if old is None:
+        os.environ.pop(CACHE_ENV, None)
+    else:
+        os.environ[CACHE_ENV] = old
+
+
+@pytest.fixture(scope="session")
+def smoke_episodes(_private_cache):
+    """The smoke profile's simulated dataset (24 episodes), recorded once per session."""
+    from pgae_lite.simdata import DATASET_PROFILES, generate
+
+    config = DATASET_PROFILES["smoke"]
+    return config, generate(config, progress=False)
 
 
 @pytest.fixture(autouse=True)

@@ -50,15 +50,6 @@ def test_missing_data_path(tmp_path):
     assert "Traceback" not in r.stderr
 
 
-def test_no_data_path_given(tmp_path, monkeypatch, capsys):
-    monkeypatch.delenv("PGAE_ORIGINAL_DATA", raising=False)
-    with pytest.raises(SystemExit) as e:
-        main(["reproduce", "--out", str(tmp_path / "out"), "--no-progress"])
-    assert e.value.code == 2
-    err = capsys.readouterr().err
-    assert "--original-data" in err and "oo222bs/PGAE" in err
-
-
 def _check_outputs(out: Path, original) -> dict:
     report = json.loads((out / "results.json").read_text())
     assert report["profile"]["name"] == "smoke" and report["seed"] == 0
@@ -112,6 +103,22 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
                  "--no-progress", "--device", "cpu"]) == 2
     assert "different profile" in capsys.readouterr().err
 
+def test_simulate_and_reproduce_on_simulated_data(smoke_episodes, tmp_path, monkeypatch, capsys):
+    """Without --original-data the whole pipeline runs on our simulator's data (smoke profile)."""
+    monkeypatch.delenv("PGAE_ORIGINAL_DATA", raising=False)
+    monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
+    assert main(["simulate", "--no-progress"]) == 0
+    assert "24 episodes" in capsys.readouterr().out                 # already recorded by the fixture
+    out = tmp_path / "sim-run"
+    assert main(["reproduce", "--out", str(out), "--no-progress", "--device", "cpu"]) == 0
+    assert "paper PGAE" in capsys.readouterr().out
+    report = json.loads((out / "results.json").read_text())
+    assert report["data"].startswith("simulated:")
+    with np.load(out / "predictions.npz", allow_pickle=False) as z:
+        assert {k for k in z.files} == {f"{s.replace(' ', '_')}_{part}" for s in TEST_SIGNALS
+                                        for part in ("ids", "text", "joints")}
+        ids = z["execute_ids"]
+    assert len(ids) == report["results"]["execute"]["n"] and all(i.startswith("sim/") for i in ids)
 
 
 def test_cli_profile_names_match_the_package():

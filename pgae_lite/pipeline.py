@@ -1,0 +1,83 @@
+"""From nothing to a dataset PGAE learns from: simulator -> CAE -> visual features.
+
+Paper, Sec. 4 (dataset) and Sec. 3 (visual features from a channel-separated
+CAE), on our simulated data. Each heavy step is cached, keyed by its config,
+so every chapter can call :func:`simulated_dataset` and get in seconds what an
+earlier chapter (or ``python -m pgae_lite simulate``) already made:
+
+1. :func:`pgae_lite.simdata.generate` records the episodes;
+2. :func:`trained_cae` trains the CAE on frames of the training episodes only;
+3. :func:`simulated_dataset` encodes every frame of both views into 30
+   features and returns a :class:`~pgae_lite.data.PGAEDataset`.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import warnings
+from pathlib import Path
+
+from .cae import (CAEConfig, ChannelSeparatedCAE, extract_features, get_cae_config, load_cae,
+                  train_cae)
+from .data import DataFormatError, PGAEDataset
+from .simdata import DATASET_PROFILES, DatasetConfig, cache_dir, generate, to_dataset, training_frames
+
+PROFILE_ENV = "PGAE_LITE_PROFILE"
+
+
+def profile_name(profile: str | None = None) -> str:
+    """``profile``, else ``$PGAE_LITE_PROFILE``, else ``book``; checked."""
+    name = profile or os.environ.get(PROFILE_ENV, "book")
+    if name not in DATASET_PROFILES:
+        raise ValueError(f"unknown profile {name!r}; the profiles are: {', '.join(DATASET_PROFILES)}")
+    return name
+
+
+def _key(config: CAEConfig) -> str:
+    return hashlib.sha1(json.dumps(config.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+
+
+def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
+    """Where the CAE trained on ``data`` with ``cae`` is cached."""
+    return cache_dir() / "cae" / f"{data.key()}-{_key(cae)}.pt"
+
+
+def trained_cae(profile: str | None = None, device: str | None = None, progress: bool = True,
+                workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
+    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
+    name = profile_name(profile)
+    data, cae = DATASET_PROFILES[name], get_cae_config(name)
+    generate(data, workers=workers, progress=progress)
+    path = cae_path(data, cae)
+    if path.exists():  # the path is keyed by both configs: no need to read the frames again
+        try:
+            model, ckpt = load_cae(path, device)
+            if ckpt["config"] == cae.to_dict():
+                return model, ckpt["history"]
+            raise ValueError(f"config {ckpt['config']} differs from {cae.to_dict()}")
+        except Exception as e:  # a damaged or foreign file: train again rather than use it
+            warnings.warn(f"{path}: cannot use this cached CAE ({e}); training it again", stacklevel=2)
+            path.unlink()
+    return train_cae(training_frames(data, cae.frame_stride), cae, device, progress, out_path=path)
+
+
+def simulated_dataset(profile: str | None = None, device: str | None = None, progress: bool = True,
+                      workers: int | None = None) -> PGAEDataset:
+    """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
+    name = profile_name(profile)
+    data, cae_config = DATASET_PROFILES[name], get_cae_config(name)
+    path = cache_dir() / "features" / f"{data.key()}-{_key(cae_config)}.npz"
+    if path.exists():
+        try:
+            return PGAEDataset.load(path)
+        except DataFormatError as e:
+            warnings.warn(f"{e}; computing the features again", stacklevel=2)
+    model, _ = trained_cae(name, device, progress, workers)
+    dataset = to_dataset(data, lambda frames: extract_features(model, frames))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    dataset.save(path)
+    return dataset
+
+
+__all__ = ["simulated_dataset", "trained_cae", "cae_path", "profile_name"]

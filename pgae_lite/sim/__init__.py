@@ -1,0 +1,26 @@
+"""Our tabletop simulator (pybullet): NICO, a table, two cubes and an opposite agent.
+
+Paper, Sec. 4 (Dataset). The authors recorded their data in a Blender scene
+that is not public; this subpackage builds an equivalent world from code a
+student can read, one concept per module:
+
+- ``robot``    the NICO-like robot (URDF generated in Python), joints, IK
+- ``scene``    table, cubes, both robots, NICO's eye camera and renderer
+- ``actions``  push / pull / slide as min-jerk hand paths through IK; the check
+- ``record``   episodes: both views, seeds and retries, determinism; ``Simulation``
+
+Quick start::
+
+    from pgae_lite.sim import record_episode
+    ep = record_episode(pattern=0, variation=0)     # push red (left cube) slowly
+    ep.joints.shape, ep.images.shape                # (100, 5), (100, 120, 160, 3)
+"""
+from .actions import ActionCheck, check_action
+from .record import (AGENTS, Episode, Execution, SimConfig, Simulation, episode_seed, execute_trajectory,
+                     record_episode, scene_layout)
+from .robot import HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot
+from .scene import CUBE_RGBA, Scene, SceneLayout
+
+__all__ = ["AGENTS", "ActionCheck", "CUBE_RGBA", "Episode", "Execution", "HOME_POSE", "JOINT_LIMITS",
+           "JOINT_NAMES", "Robot", "Scene", "SceneLayout", "SimConfig", "Simulation", "check_action",
+           "episode_seed", "execute_trajectory", "record_episode", "scene_layout"]

@@ -1,0 +1,303 @@
+"""The simulated dataset: every pattern recorded in our simulator, cached on disk.
+
+Paper, Sec. 4 (Dataset), with our pybullet world (:mod:`pgae_lite.sim`) in
+place of the authors' Blender scenes: the same 144 patterns (12 cube
+arrangements x 12 actions) x 6 variations = 864 episodes, the same 36 test
+patterns, joints padded to 100 steps, 120x160 images of NICO's own view and of
+the opposite agent's.
+
+Recording takes minutes, so episodes go through a cache keyed by the
+generation config:
+
+    {cache}/episodes/{key}/config.json         what was asked for
+    {cache}/episodes/{key}/PPP-V.npz           one episode (joints, both views, ...)
+    {cache}/episodes/{key}/manifest.json       episode -> seed, attempts, file digest
+
+Each file is written atomically (a temporary file, then a rename), so an
+interrupted run leaves only whole files; the next run records only what is
+missing. A file whose digest does not match the manifest (or, if it is not in
+the manifest yet, whose contents fail their own check) is reported and
+recorded again, never used.
+
+:func:`simulated_dataset` turns the episodes into the same
+:class:`~pgae_lite.data.PGAEDataset` as the authors' loader produces, with
+visual features from a trained channel-separated CAE (also cached).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass, field
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Callable, Iterator
+
+import numpy as np
+from tqdm.auto import tqdm
+
+from .data import MAX_STEPS, PGAEDataset, Pattern
+from .sim.record import Episode, SimConfig, record_episode
+
+CACHE_ENV = "PGAE_LITE_CACHE"
+#: Bump when the simulator changes what it records: old caches are then not reused.
+GENERATOR_VERSION = 1
+IMAGE_SHAPE = (120, 160, 3)
+
+
+def cache_dir() -> Path:
+    """Root of every cache: ``$PGAE_LITE_CACHE``, else ``~/.cache/pgae_lite``."""
+    return Path(os.environ.get(CACHE_ENV) or Path.home() / ".cache" / "pgae_lite").expanduser()
+
+
+@dataclass(frozen=True)
+class DatasetConfig:
+    """What to record: which patterns, how many variations of each, from which seed."""
+
+    variations: int = 6
+    patterns: tuple[int, ...] | None = None   # None: all 144
+    base_seed: int = 0
+    sim: SimConfig = field(default_factory=SimConfig)
+
+    def pattern_list(self) -> list[int]:
+        return list(range(144)) if self.patterns is None else sorted(self.patterns)
+
+    def episodes(self) -> list[tuple[int, int]]:
+        """(pattern, variation) of every episode, in a fixed order."""
+        return [(p, v) for p in self.pattern_list() for v in range(self.variations)]
+
+    def key(self) -> str:
+        """Short digest of the config (and the generator version): the cache folder's name."""
+        text = json.dumps({"version": GENERATOR_VERSION, **asdict(self)}, sort_keys=True, default=str)
+        return hashlib.sha1(text.encode()).hexdigest()[:12]
+
+
+#: Two arrangements (0: red+blue, 7: cyan+yellow), every action at both speeds;
+#: 10 of these 24 patterns are test patterns.
+SMOKE_PATTERNS = tuple(sorted(72 * s + 6 * a + i for s in (0, 1) for a in (0, 7) for i in range(6)))
+DATASET_PROFILES: dict[str, DatasetConfig] = {
+    "smoke": DatasetConfig(variations=1, patterns=SMOKE_PATTERNS),
+    "book": DatasetConfig(),
+    "paper": DatasetConfig(),
+}
+
+
+class CorruptEpisodeError(RuntimeError):
+    """A cached episode file is damaged or does not match what was recorded."""
+
+
+# --------------------------------------------------------------------------- one file per episode
+def episode_name(pattern: int, variation: int) -> str:
+    return f"{pattern:03d}-{variation}"
+
+
+def _content_digest(arrays: dict[str, np.ndarray]) -> str:
+    h = hashlib.blake2b(digest_size=16)
+    for k in sorted(arrays):
+        h.update(k.encode())
+        h.update(np.ascontiguousarray(arrays[k]).tobytes())
+    return h.hexdigest()
+
+
+def file_digest(path: Path) -> str:
+    """Digest of a file's bytes (the manifest's check)."""
+    h = hashlib.blake2b(digest_size=16)
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def save_episode(path: Path, ep: Episode) -> None:
+    """Write one episode atomically, with a digest of its contents inside."""
+    arrays = {"joints": ep.joints, "images": ep.images, "images_opposite": ep.images_opposite,
+              "displacement": ep.displacement,
+              "meta": np.array([ep.pattern, ep.variation, ep.seed, ep.attempts], dtype=np.int64)}
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+    with open(tmp, "wb") as f:
+        np.savez_compressed(f, digest=np.array(_content_digest(arrays)), **arrays)
+    os.replace(tmp, path)
+
+
+def load_episode_file(path: Path) -> Episode:
+    """Read and check one episode file; :class:`CorruptEpisodeError` if it is damaged."""
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            arrays = {k: f[k] for k in ("joints", "images", "images_opposite", "displacement", "meta")}
+            digest = str(f["digest"])
+    except Exception as e:  # zip, zlib or format errors: all mean the same thing here
+        raise CorruptEpisodeError(f"{path}: unreadable ({type(e).__name__}: {e})") from None
+    if _content_digest(arrays) != digest:
+        raise CorruptEpisodeError(f"{path}: contents do not match their digest")
+    pattern, variation, seed, attempts = (int(x) for x in arrays["meta"])
+    steps = Pattern.from_number(pattern).steps
+    if (arrays["joints"].shape != (steps, 5) or arrays["images"].shape != (steps, *IMAGE_SHAPE)
+            or arrays["images_opposite"].shape != (steps, *IMAGE_SHAPE)):
+        raise CorruptEpisodeError(f"{path}: unexpected shapes {arrays['joints'].shape}, {arrays['images'].shape}")
+    return Episode(pattern=pattern, variation=variation, seed=seed, attempts=attempts,
+                   joints=arrays["joints"], images=arrays["images"],
+                   images_opposite=arrays["images_opposite"], displacement=arrays["displacement"], valid=True)
+
+
+def _record_and_save(args: tuple[int, int, SimConfig, int, str]) -> dict:
+    """Worker: record one episode, save it, return its manifest entry."""
+    pattern, variation, sim_config, base_seed, folder = args
+    t0 = time.perf_counter()
+    ep = record_episode(pattern, variation, sim_config, base_seed)
+    path = Path(folder) / f"{episode_name(pattern, variation)}.npz"
+    save_episode(path, ep)
+    return {"name": episode_name(pattern, variation), "seed": ep.seed, "attempts": ep.attempts,
+            "steps": len(ep.joints), "digest": file_digest(path), "seconds": time.perf_counter() - t0}
+
+
+# --------------------------------------------------------------------------- the whole set
+@dataclass
+class GenerationReport:
+    """What :func:`generate` did."""
+
+    folder: Path
+    episodes: int              # episodes in the dataset
+    recorded: int              # recorded in this call (the rest came from the cache)
+    corrupt: int               # damaged files found and recorded again
+    first_try: float           # fraction of all episodes valid on their first seed
+    seconds: float             # wall time of this call
+    megabytes: float           # size of the episode files on disk
+
+
+def episode_folder(config: DatasetConfig) -> Path:
+    return cache_dir() / "episodes" / config.key()
+
+
+def _read_manifest(folder: Path) -> dict[str, dict]:
+    try:
+        return json.loads((folder / "manifest.json").read_text())
+    except (OSError, ValueError):
+        return {}
+
+
+def _write_json(path: Path, obj) -> None:
+    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
+    tmp.write_text(json.dumps(obj, indent=1, sort_keys=True))
+    os.replace(tmp, path)
+
+
+def generate(config: DatasetConfig | None = None, workers: int | None = None,
+             progress: bool = True) -> GenerationReport:
+    """Record every episode of ``config`` that the cache does not hold yet.
+
+    ``workers`` processes record in parallel (default: one per CPU core).
+    Safe to interrupt and to call again; damaged files are recorded again.
+    """
+    config = config or DATASET_PROFILES["book"]
+    t0 = time.perf_counter()
+    folder = episode_folder(config)
+    folder.mkdir(parents=True, exist_ok=True)
+    _write_json(folder / "config.json", {"version": GENERATOR_VERSION, **asdict(config)})
+    manifest = _read_manifest(folder)
+    todo, corrupt = [], 0
+    for p, v in config.episodes():
+        name = episode_name(p, v)
+        path = folder / f"{name}.npz"
+        if not path.exists():
+            todo.append((p, v))
+            continue
+        entry = manifest.get(name)
+        if entry is not None and file_digest(path) == entry["digest"]:
+            continue
+        try:                      # a whole file that never reached the manifest, or a damaged one
+            ep = load_episode_file(path)
+            if entry is not None:
+                raise CorruptEpisodeError(f"{path}: file digest differs from the manifest")
+            manifest[name] = {"name": name, "seed": ep.seed, "attempts": ep.attempts,
+                              "steps": len(ep.joints), "digest": file_digest(path), "seconds": 0.0}
+        except CorruptEpisodeError as e:
+            warnings.warn(f"{e}; recording it again", stacklevel=2)
+            corrupt += 1
+            manifest.pop(name, None)
+            todo.append((p, v))
+    jobs = [(p, v, config.sim, config.base_seed, str(folder)) for p, v in todo]
+    workers = max(1, min(workers or os.cpu_count() or 1, len(jobs)))
+    bar = tqdm(total=len(jobs), desc="recording episodes", disable=not progress or not jobs, unit="ep")
+    last_save = time.perf_counter()
+    for entry in _run(jobs, workers):
+        manifest[entry["name"]] = entry
+        bar.update()
+        if time.perf_counter() - last_save > 5:      # keep the manifest current if interrupted
+            _write_json(folder / "manifest.json", manifest)
+            last_save = time.perf_counter()
+    bar.close()
+    _write_json(folder / "manifest.json", manifest)
+    names = [episode_name(p, v) for p, v in config.episodes()]
+    first = np.mean([manifest[n]["attempts"] == 1 for n in names])
+    size = sum((folder / f"{n}.npz").stat().st_size for n in names) / 1e6
+    return GenerationReport(folder, len(names), len(jobs), corrupt, float(first),
+                            time.perf_counter() - t0, size)
+
+
+def _run(jobs: list, workers: int) -> Iterator[dict]:
+    if workers == 1:
+        yield from map(_record_and_save, jobs)
+        return
+    # "spawn": fresh interpreters, safe beside torch threads and inside notebooks.
+    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+        yield from pool.map(_record_and_save, jobs, chunksize=1)
+
+
+def load_episode(config: DatasetConfig, pattern: int, variation: int = 0) -> Episode:
+    """One recorded episode (recording the whole dataset first if the cache lacks it)."""
+    if (pattern, variation) not in set(config.episodes()):
+        raise ValueError(f"episode (pattern {pattern}, variation {variation}) is not in this dataset: "
+                         f"patterns {config.pattern_list()[0]}..{config.pattern_list()[-1]}, "
+                         f"variations 0..{config.variations - 1}")
+    path = episode_folder(config) / f"{episode_name(pattern, variation)}.npz"
+    if not path.exists():
+        generate(config)
+    return load_episode_file(path)
+
+
+def iter_episodes(config: DatasetConfig, split: str | None = None) -> Iterator[Episode]:
+    """Every episode of the dataset in order (``split``: ``"train"``, ``"test"`` or all)."""
+    generate(config, progress=False)
+    for p, v in config.episodes():
+        if split is None or Pattern.from_number(p).is_test == (split == "test"):
+            yield load_episode_file(episode_folder(config) / f"{episode_name(p, v)}.npz")
+
+
+def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ...] = ("images", "images_opposite")
+                    ) -> np.ndarray:
+    """Every ``stride``-th frame of the training episodes, both views: CAE training images (N, 120, 160, 3)."""
+    frames = [getattr(ep, view)[::stride] for ep in iter_episodes(config, "train") for view in views]
+    return np.concatenate(frames)
+
+
+def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray]) -> PGAEDataset:
+    """The episodes as a :class:`PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
+    rows: dict[str, list] = {k: [] for k in (
+        "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
+        "ids", "action", "arrangement")}
+    for ep in iter_episodes(config):
+        pat = Pattern.from_number(ep.pattern)
+        n = len(ep.joints)
+        pad = ((0, MAX_STEPS - n), (0, 0))
+        rows["joints"].append(np.pad(ep.joints, pad))
+        rows["vision"].append(np.pad(features(ep.images), pad))
+        rows["vision_opposite"].append(np.pad(features(ep.images_opposite), pad))
+        rows["lengths"].append(n)
+        rows["descriptions"].append(pat.descriptions())
+        rows["pattern"].append(ep.pattern)
+        rows["is_test"].append(pat.is_test)
+        rows["ids"].append(f"sim/{episode_name(ep.pattern, ep.variation)}")
+        rows["action"].append(pat.code)
+        rows["arrangement"].append(f"{pat.left}+{pat.right}")
+    arrays = {k: np.asarray(v) for k, v in rows.items()}
+    for k in ("joints", "vision", "vision_opposite"):
+        arrays[k] = arrays[k].astype(np.float32)
+    return PGAEDataset(**arrays, source=f"simulated:{config.key()}")
+
+
+__all__ = ["DatasetConfig", "DATASET_PROFILES", "SMOKE_PATTERNS", "GenerationReport", "CorruptEpisodeError",
+           "cache_dir", "generate", "load_episode", "iter_episodes", "training_frames", "to_dataset",
+           "episode_folder", "save_episode", "load_episode_file"]
