@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import torch
 from torch import nn
+from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
 from .train import CheckpointMismatchError, default_device
@@ -97,13 +98,13 @@ class ChannelAutoencoder(nn.Module):
         # past a CPU budget. With it, arm and cube colours appear within ~300 iterations.
         enc: list[nn.Module] = []
         for i, (kernel, stride, pad) in enumerate(k):
-            enc += [nn.Conv2d(c[i], c[i + 1], kernel, stride, pad, bias=False), nn.BatchNorm2d(c[i + 1]), nn.ReLU()]
+            enc += [nn.Conv2d(c[i], c[i + 1], kernel, stride, pad, bias=False), nn.BatchNorm2d(c[i + 1]), nn.ReLU(inplace=True)]
         self.conv = nn.Sequential(*enc)
         self.map_shape = (c[-1], HEIGHT // 8 // 5, WIDTH // 8 // 5)  # (64, 3, 4)
         sizes = [c[-1] * self.map_shape[1] * self.map_shape[2], *config.hidden]  # [768, 384, 192]
         fc: list[nn.Module] = []
         for a, b in zip(sizes, sizes[1:]):
-            fc += [nn.Linear(a, b), nn.ReLU()]
+            fc += [nn.Linear(a, b), nn.ReLU(inplace=True)]
         # Deviation from paper (authors' code): ReLU between the fully connected layers
         # (authors: none, so 768-384-192-10 was one linear map) and a tanh on the
         # bottleneck (authors: linear, features in about ±60). tanh keeps the features
@@ -112,7 +113,7 @@ class ChannelAutoencoder(nn.Module):
         up: list[nn.Module] = []
         back = [config.features, *sizes[::-1]]   # [10, 192, 384, 768]
         for a, b in zip(back, back[1:]):
-            up += [nn.Linear(a, b), nn.ReLU()]
+            up += [nn.Linear(a, b), nn.ReLU(inplace=True)]
         self.unfc = nn.Sequential(*up)           # 10 -> 192 -> 384 -> 768
         # Deviation from paper (authors' code): the decoder mirrors the encoder
         # (10-192-384-768, deconvs 64-32-16-8-1); the authors' went 10-192-384 and
@@ -122,7 +123,7 @@ class ChannelAutoencoder(nn.Module):
             extra = 1 if stride == 5 else 0      # 3x4 -> 14x19 without it; 15x20 with it
             last = i == 0                        # the last layer gives logits: a bias, no BN, no ReLU
             dec += [nn.ConvTranspose2d(c[i + 1], c[i], kernel, stride, pad, output_padding=extra, bias=last)]
-            dec += [] if last else [nn.BatchNorm2d(c[i]), nn.ReLU()]
+            dec += [] if last else [nn.BatchNorm2d(c[i]), nn.ReLU(inplace=True)]
         self.deconv = nn.Sequential(*dec)
 
     def encode(self, x: torch.Tensor) -> torch.Tensor:
@@ -139,6 +140,16 @@ class ChannelAutoencoder(nn.Module):
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         """Reconstruction x̂ = sigmoid(decoder(encoder(x))), (B, 1, 120, 160) in [0, 1]."""
         return torch.sigmoid(self.logits(self.encode(x)))
+
+    def fused_encoder(self) -> nn.Sequential:
+        """The encoder for inference, each BatchNorm folded into the conv before it: same output, ~2x faster."""
+        layers, out = list(self.conv), []
+        for i, layer in enumerate(layers):
+            if isinstance(layer, nn.Conv2d):     # conv, then its BN: w' = w·γ/σ, b' = β − μ·γ/σ
+                out.append(fuse_conv_bn_eval(layer, layers[i + 1]))
+            elif not isinstance(layer, nn.BatchNorm2d):
+                out.append(layer)
+        return nn.Sequential(*out, nn.Flatten(), *self.fc).eval()  # (B, 1, 120, 160) -> (B, 10)
 
 
 def as_input(images: np.ndarray | torch.Tensor, device: torch.device | str | None = None) -> torch.Tensor:
@@ -274,15 +285,23 @@ def load_cae(path: str | Path, device: torch.device | str | None = None) -> tupl
 
 
 @torch.inference_mode()
-def extract_features(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tensor, batch: int = 256) -> np.ndarray:
-    """Visual features (N, 30) float32 of ``images``, ``batch`` at a time, on the model's device."""
+def extract_features(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tensor, batch: int = 128) -> np.ndarray:
+    """Visual features (N, 30) float32 of ``images``, ``batch`` at a time, on the model's device.
+
+    Equal to ``model.encode(images)`` (to float precision), in batches, so the
+    whole dataset never has to sit in memory as float.
+    """
     model.eval()
-    out = [model.encode(images[i:i + batch]).float().cpu() for i in range(0, len(images), batch)]
+    encoders = [ae.fused_encoder() for ae in model.channels]
+    out = []
+    for i in range(0, len(images), batch):
+        channels = model._split(images[i:i + batch])   # 3 x (b, 1, 120, 160)
+        out.append(torch.cat([enc(x) for enc, x in zip(encoders, channels)], dim=1).float().cpu())  # (b, 30)
     return torch.cat(out).numpy() if out else np.zeros((0, 3 * model.config.features), np.float32)
 
 
 @torch.inference_mode()
-def reconstruct(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tensor, batch: int = 256) -> np.ndarray:
+def reconstruct(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tensor, batch: int = 128) -> np.ndarray:
     """Reconstructions as uint8 (N, 120, 160, 3): for looking at what the 30 features keep."""
     model.eval()
     out = [(model(images[i:i + batch]) * 255).round().byte().permute(0, 2, 3, 1).cpu()  # -> (b, 120, 160, 3)
