@@ -14,32 +14,38 @@ import tempfile
 import time
 from pathlib import Path
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-ap.add_argument("--profile", default="book")
-ap.add_argument("--cache", default=None, help="cache folder (default: a new temporary folder)")
-ap.add_argument("--workers", type=int, default=None)
-ap.add_argument("--skip-cae", action="store_true", help="time the recording only")
-args = ap.parse_args()
-os.environ["PGAE_LITE_CACHE"] = args.cache or tempfile.mkdtemp(prefix="pgae-cache-")
 
-from pgae_lite.pipeline import simulated_dataset, trained_cae  # noqa: E402  (after the cache is set)
-from pgae_lite.simdata import DATASET_PROFILES, generate  # noqa: E402
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--profile", default="book")
+    ap.add_argument("--cache", default=None, help="cache folder (default: a new temporary folder)")
+    ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--skip-cae", action="store_true", help="time the recording only")
+    args = ap.parse_args()
+    os.environ["PGAE_LITE_CACHE"] = args.cache or tempfile.mkdtemp(prefix="pgae-cache-")
 
-row = {"profile": args.profile, "cache": os.environ["PGAE_LITE_CACHE"], "cpus": os.cpu_count()}
-t0 = time.perf_counter()
-report = generate(DATASET_PROFILES[args.profile], workers=args.workers)
-row.update(record_s=round(time.perf_counter() - t0, 1), episodes=report.episodes,
-           first_try_pct=round(100 * report.first_try, 2), megabytes=round(report.megabytes, 1))
-print(json.dumps(row), flush=True)
-if not args.skip_cae:
+    from pgae_lite.pipeline import simulated_dataset, trained_cae  # after the cache is set
+    from pgae_lite.simdata import DATASET_PROFILES, generate
+
+    row = {"profile": args.profile, "cache": os.environ["PGAE_LITE_CACHE"], "cpus": os.cpu_count()}
     t0 = time.perf_counter()
-    _, history = trained_cae(args.profile)
-    row.update(cae_s=round(time.perf_counter() - t0, 1), cae_final_loss=round(history[-1]["loss"], 4))
-    t0 = time.perf_counter()
-    ds = simulated_dataset(args.profile)
-    row.update(features_s=round(time.perf_counter() - t0, 1), samples=len(ds))
-print(json.dumps(row), flush=True)
-out = Path(__file__).parent / "out"
-out.mkdir(exist_ok=True)
-with open(out / "dataset_pipeline.jsonl", "a") as f:
-    f.write(json.dumps(row) + "\n")
+    report = generate(DATASET_PROFILES[args.profile], workers=args.workers)
+    row.update(record_s=round(time.perf_counter() - t0, 1), episodes=report.episodes,
+               first_try_pct=round(100 * report.first_try, 2), megabytes=round(report.megabytes, 1))
+    print(json.dumps(row), flush=True)
+    if not args.skip_cae:
+        t0 = time.perf_counter()
+        _, history = trained_cae(args.profile)
+        row.update(cae_s=round(time.perf_counter() - t0, 1), cae_final_loss=round(history[-1]["loss"], 4))
+        t0 = time.perf_counter()
+        ds = simulated_dataset(args.profile)
+        row.update(features_s=round(time.perf_counter() - t0, 1), samples=len(ds))
+    print(json.dumps(row), flush=True)
+    out = Path(__file__).parent / "out"
+    out.mkdir(exist_ok=True)
+    with open(out / "dataset_pipeline.jsonl", "a") as f:
+        f.write(json.dumps(row) + "\n")
+
+
+if __name__ == "__main__":  # the recording workers are spawned: they re-import this file
+    main()

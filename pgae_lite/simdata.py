@@ -188,7 +188,8 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
              progress: bool = True) -> GenerationReport:
     """Record every episode of ``config`` that the cache does not hold yet.
 
-    ``workers`` processes record in parallel (default: one per CPU core).
+    ``workers`` processes record in parallel (default: one per CPU core); they are
+    spawned, so a script that calls this needs the usual ``if __name__ == "__main__":`` guard.
     Safe to interrupt and to call again; damaged files are recorded again.
     """
     config = config or DATASET_PROFILES["book"]
