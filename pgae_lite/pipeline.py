@@ -74,7 +74,7 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
         except DataFormatError as e:
             warnings.warn(f"{e}; computing the features again", stacklevel=2)
     model, _ = trained_cae(name, device, progress, workers)
-    dataset = to_dataset(data, lambda frames: extract_features(model, frames))
+    dataset = to_dataset(data, lambda frames: extract_features(model, frames), progress)
     path.parent.mkdir(parents=True, exist_ok=True)
     dataset.save(path)
     return dataset

@@ -288,12 +288,14 @@ def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ..
     return np.concatenate(frames)
 
 
-def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray]) -> PGAEDataset:
+def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray],
+               progress: bool = True) -> PGAEDataset:
     """The episodes as a :class:`PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
     rows: dict[str, list] = {k: [] for k in (
         "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
         "ids", "action", "arrangement")}
-    for ep in iter_episodes(config):
+    for ep in tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
+                   unit="ep", disable=not progress):
         pat = Pattern.from_number(ep.pattern)
         n = len(ep.joints)
         pad = ((0, MAX_STEPS - n), (0, 0))
