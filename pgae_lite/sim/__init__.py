@@ -15,6 +15,11 @@ Quick start::
     ep = record_episode(pattern=0, variation=0)     # push red (left cube) slowly
     ep.joints.shape, ep.images.shape                # (100, 5), (100, 120, 160, 3)
 """
+from ._quiet import silenced
+
+with silenced(2):  # pybullet announces its build time on stderr when first imported
+    import pybullet  # noqa: F401
+
 from .actions import ActionCheck, check_action
 from .record import (AGENTS, Episode, Execution, SimConfig, Simulation, episode_seed, execute_trajectory,
                      record_episode, scene_layout)

@@ -36,6 +36,7 @@ import pybullet as p
 from pybullet_utils import bullet_client
 
 from ..language import COLOURS
+from ._quiet import silenced
 from .robot import Robot
 
 #: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.language`.
@@ -65,6 +66,13 @@ IMAGE_HEIGHT, IMAGE_WIDTH = 120, 160
 CAMERA_FOV_DEG = 64.0                     # vertical field of view of the eye camera
 LIGHT_DIRECTION = (0.6, 0.4, 1.0)         # towards the light, world frame
 BACKGROUND_RGB = (214, 222, 232)          # the wall behind the table (nothing rendered there)
+
+
+def _quiet_client() -> bullet_client.BulletClient:
+    """A headless pybullet world (pybullet's C code prints ``argv[0]=`` on every
+    connection: silenced, so that it does not fill notebooks)."""
+    with silenced(1):
+        return bullet_client.BulletClient(connection_mode=p.DIRECT)
 
 
 @dataclass
@@ -99,7 +107,7 @@ class Scene:
                  time_step: float = 1.0 / 240.0, hand_friction: float = 0.3, solver_iterations: int = 20,
                  image_size: tuple[int, int] = (IMAGE_HEIGHT, IMAGE_WIDTH),
                  client: bullet_client.BulletClient | None = None) -> None:
-        self.client = client or bullet_client.BulletClient(connection_mode=p.DIRECT)
+        self.client = client or _quiet_client()
         self.image_size = image_size          # (height, width) pixels
         self.time_step = time_step
         self.hand_friction = hand_friction
