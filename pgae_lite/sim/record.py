@@ -36,7 +36,7 @@ import numpy as np
 from ..data import Pattern
 from .actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
                       check_action, plan_action, sample_variation, world_direction)
-from .robot import HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot
+from .robot import JOINT_LIMITS, JOINT_NAMES, Robot
 from .scene import CUBE_Y, IMAGE_HEIGHT, IMAGE_WIDTH, TABLE_CENTRE_X, Scene, SceneLayout
 
 AGENTS = ("nico", "opposite")
