@@ -46,6 +46,7 @@ CACHE_ENV = "PGAE_LITE_CACHE"
 #: Bump when the simulator changes what it records: old caches are then not reused.
 GENERATOR_VERSION = 2
 IMAGE_SHAPE = (120, 160, 3)
+MIN_JOBS_PER_WORKER = 24      # below this many episodes per process, one process is faster
 
 
 def cache_dir() -> Path:
@@ -202,7 +203,8 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
              progress: bool = True) -> GenerationReport:
     """Record every episode of ``config`` that the cache does not hold yet.
 
-    ``workers`` processes record in parallel (default: one per CPU core); they are
+    ``workers`` processes record in parallel (default: one per CPU core, or one
+    process for a few dozen episodes, where starting workers costs more); they are
     spawned, so a script that calls this needs the usual ``if __name__ == "__main__":`` guard.
     Safe to interrupt and to call again; damaged files are recorded again.
     """
@@ -234,7 +236,9 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
             manifest.pop(name, None)
             todo.append((p, v))
     jobs = [(p, v, config.sim, config.base_seed, str(folder)) for p, v in todo]
-    workers = max(1, min(workers or os.cpu_count() or 1, len(jobs)))
+    if workers is None:   # a new worker process takes seconds to start (it imports torch): not worth it for few jobs
+        workers = (os.cpu_count() or 1) if len(jobs) >= 2 * MIN_JOBS_PER_WORKER else 1
+    workers = max(1, min(workers, len(jobs)))
     bar = tqdm(total=len(jobs), desc="recording episodes", disable=not progress or not jobs, unit="ep")
     last_save = time.perf_counter()
     for entry in _run(jobs, workers):

@@ -479,13 +479,15 @@ def plot_cae_history(history: Sequence[Mapping], smooth: int = 25, floor: Sequen
 
 
 def plot_features_over_time(frames: np.ndarray, features: np.ndarray | torch.Tensor, joints=None,
-                            count: int = 6, vmax: float = 1.0, title: str = "") -> Figure:
+                            count: int = 6, vmax: float = 1.0, title: str = "",
+                            joint_names: Sequence[str] = JOINT_NAMES) -> Figure:
     """A film strip of ``count`` frames above the visual features of every step, on one time axis.
 
     ``frames`` (T, H, W, 3) uint8 and ``features`` (T, F) of the same steps,
     F = 3 x features per channel (R, G, B blocks, separated by white lines);
     dotted lines mark the steps of the strip. With ``joints`` (T, 5) a third
-    panel plots them below. Colours span ``[-vmax, vmax]``.
+    panel plots them below, labelled with ``joint_names``. Colours span
+    ``[-vmax, vmax]``.
     """
     frames, features = _numpy(frames), _numpy(features)
     steps = np.linspace(0, len(frames) - 1, count).round().astype(int)
@@ -507,8 +509,9 @@ def plot_features_over_time(frames: np.ndarray, features: np.ndarray | torch.Ten
     axes = [heat]
     if joints is not None:
         ax = fig.add_subplot(grid[2, :], sharex=heat)
-        ax.plot(_numpy(joints))
+        ax.plot(_numpy(joints), label=list(joint_names))
         ax.set(ylabel="joints (rad)")
+        ax.legend(fontsize="x-small", ncol=len(joint_names), loc="upper left")
         axes.append(ax)
     fig.colorbar(im, ax=axes, pad=0.01, fraction=0.03, label="feature value")  # one bar: the time axes stay aligned
     for ax in axes:

@@ -175,9 +175,11 @@ def test_feature_plots_draw_every_step_and_row():
 
     frames = np.zeros((20, 12, 16, 3), np.uint8)
     features = np.linspace(-1, 1, 20 * 30).reshape(20, 30)
-    fig = plot_features_over_time(frames, features, joints=np.zeros((20, 5)), count=4)
+    fig = plot_features_over_time(frames, features, joints=np.zeros((20, 5)), count=4, joint_names="abcde")
     heat = [ax for ax in fig.axes if ax.images and ax.images[0].get_array().shape == (30, 20)]
     assert len(heat) == 1                                          # features (T, F) drawn as (F, T)
+    legends = [ax.get_legend() for ax in fig.axes if ax.get_legend()]
+    assert [t.get_text() for t in legends[0].get_texts()] == list("abcde")
     assert sum(1 for ax in fig.axes if ax.get_title().startswith("t = ")) == 4
     fig = plot_feature_rows({"a": frames[0], "b": frames[1]}, features[:2])
     assert sum(1 for ax in fig.axes if ax.images and ax.images[0].get_array().shape == (1, 30)) == 2
