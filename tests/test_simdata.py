@@ -78,3 +78,14 @@ def test_simulated_dataset_has_the_authors_layout(smoke_episodes):
     assert not np.allclose(ds.vision, ds.vision_opposite)
     again = simulated_dataset("smoke", progress=False)                 # from the features cache
     np.testing.assert_array_equal(again.vision, ds.vision)
+
+
+def test_parallel_workers_record_the_same_bytes_as_one_process():
+    from pgae_lite.sim.record import record_episode
+
+    config = DatasetConfig(variations=2, patterns=(77,))            # two fast episodes
+    report = generate(config, workers=2, progress=False)
+    assert report.recorded == 2
+    for v in range(2):
+        stored, direct = load_episode(config, 77, v), record_episode(77, v, config.sim, config.base_seed)
+        assert np.array_equal(stored.images, direct.images) and np.array_equal(stored.joints, direct.joints)
