@@ -163,8 +163,9 @@ class ChannelAutoencoder(nn.Module):
         """The encoder for inference, each BatchNorm folded into the conv before it: same output, ~2x faster."""
         layers, out = list(self.conv), []
         for i, layer in enumerate(layers):
-            if isinstance(layer, nn.Conv2d):     # conv, then its BN: w' = w·γ/σ, b' = β − μ·γ/σ
-                out.append(fuse_conv_bn_eval(layer, layers[i + 1]))
+            nxt = layers[i + 1] if i + 1 < len(layers) else None
+            if isinstance(layer, nn.Conv2d) and isinstance(nxt, nn.BatchNorm2d):
+                out.append(fuse_conv_bn_eval(layer, nxt))  # conv, then its BN: w' = w·γ/σ, b' = β − μ·γ/σ
             elif not isinstance(layer, nn.BatchNorm2d):
                 out.append(layer)
         return nn.Sequential(*out, nn.Flatten(), *self.fc).eval()  # (B, 1, 120, 160) -> (B, 10)

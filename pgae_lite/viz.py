@@ -511,7 +511,7 @@ def plot_features_over_time(frames: np.ndarray, features: np.ndarray | torch.Ten
         ax = fig.add_subplot(grid[2, :], sharex=heat)
         ax.plot(_numpy(joints), label=list(joint_names))
         ax.set(ylabel="joints (rad)")
-        ax.legend(fontsize="x-small", ncol=len(joint_names), loc="upper left")
+        ax.legend(fontsize="x-small", ncol=len(joint_names), loc="best", framealpha=0.8)
         axes.append(ax)
     fig.colorbar(im, ax=axes, pad=0.01, fraction=0.03, label="feature value")  # one bar: the time axes stay aligned
     for ax in axes:

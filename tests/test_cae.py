@@ -151,3 +151,18 @@ def test_profiles(monkeypatch):
     with pytest.raises(ValueError, match="unknown CAE profile"):
         get_cae_config("fast")
     assert CAEConfig.from_dict(paper.to_dict()) == paper
+
+
+def test_extraction_works_without_batchnorm():
+    """A student's variant with BatchNorm removed (an exercise) still extracts features."""
+    import torch.nn as nn
+
+    from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features
+
+    model = ChannelSeparatedCAE(CAEConfig("smoke")).eval()
+    for ae in (model.red, model.green, model.blue):
+        ae.conv = nn.Sequential(*[nn.Identity() if isinstance(m, nn.BatchNorm2d) else m for m in ae.conv])
+    images = np.random.default_rng(0).integers(0, 256, (3, 120, 160, 3), dtype=np.uint8)
+    with torch.no_grad():
+        expected = model.encode(images)
+    np.testing.assert_allclose(extract_features(model, images), expected.numpy(), atol=1e-5)
