@@ -15,6 +15,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Iterable
 
 import numpy as np
 import torch
@@ -316,10 +317,36 @@ def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:
     return {i: (a[0], arr, a[1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
 
 
+def from_recordings(recordings: Iterable[tuple[Pattern, str, np.ndarray, np.ndarray, np.ndarray]],
+                    source: str) -> PGAEDataset:
+    """A :class:`PGAEDataset` from recordings ``(pattern, id, joints (n, 5), vision (n, 30), opposite (n, 30))``.
+
+    Pads every recording to ``MAX_STEPS`` and derives the descriptions, split,
+    action and arrangement from its pattern.
+    """
+    rows: dict[str, list] = {k: [] for k in _ARRAYS}
+    for pattern, sample_id, joints, vision, opposite in recordings:
+        pad = ((0, MAX_STEPS - len(joints)), (0, 0))
+        rows["joints"].append(np.pad(joints, pad))
+        rows["vision"].append(np.pad(vision, pad))
+        rows["vision_opposite"].append(np.pad(opposite, pad))
+        rows["lengths"].append(len(joints))
+        rows["descriptions"].append(pattern.descriptions())
+        rows["pattern"].append(pattern.number)
+        rows["is_test"].append(pattern.is_test)
+        rows["ids"].append(sample_id)
+        rows["action"].append(pattern.code)
+        rows["arrangement"].append(f"{pattern.left}+{pattern.right}")
+    arrays = {k: np.asarray(v) for k, v in rows.items()}
+    for k in ("joints", "vision", "vision_opposite"):
+        arrays[k] = arrays[k].astype(np.float32)
+    return PGAEDataset(**arrays, source=source)
+
+
 def description_text(indices: np.ndarray) -> str:
     """Word indices of one description -> text."""
     return " ".join(VOCABULARY[int(i)] for i in indices)
 
 
-__all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "load_original", "description_text",
+__all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "load_original", "from_recordings", "description_text",
            "MAX_STEPS", "JOINT_DIM", "VISION_DIM", "Pattern", "ARRANGEMENTS", "TEST_PATTERNS"]

@@ -39,7 +39,7 @@ from typing import Callable, Iterator
 import numpy as np
 from tqdm.auto import tqdm
 
-from .data import MAX_STEPS, PGAEDataset, Pattern
+from .data import PGAEDataset, Pattern, from_recordings
 from .sim.record import Episode, SimConfig, record_episode
 
 CACHE_ENV = "PGAE_LITE_CACHE"
@@ -295,28 +295,11 @@ def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ..
 def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray],
                progress: bool = True) -> PGAEDataset:
     """The episodes as a :class:`PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
-    rows: dict[str, list] = {k: [] for k in (
-        "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
-        "ids", "action", "arrangement")}
-    for ep in tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
-                   unit="ep", disable=not progress):
-        pat = Pattern.from_number(ep.pattern)
-        n = len(ep.joints)
-        pad = ((0, MAX_STEPS - n), (0, 0))
-        rows["joints"].append(np.pad(ep.joints, pad))
-        rows["vision"].append(np.pad(features(ep.images), pad))
-        rows["vision_opposite"].append(np.pad(features(ep.images_opposite), pad))
-        rows["lengths"].append(n)
-        rows["descriptions"].append(pat.descriptions())
-        rows["pattern"].append(ep.pattern)
-        rows["is_test"].append(pat.is_test)
-        rows["ids"].append(f"sim/{episode_name(ep.pattern, ep.variation)}")
-        rows["action"].append(pat.code)
-        rows["arrangement"].append(f"{pat.left}+{pat.right}")
-    arrays = {k: np.asarray(v) for k, v in rows.items()}
-    for k in ("joints", "vision", "vision_opposite"):
-        arrays[k] = arrays[k].astype(np.float32)
-    return PGAEDataset(**arrays, source=f"simulated:{config.key()}")
+    episodes = tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
+                    unit="ep", disable=not progress)
+    return from_recordings(((Pattern.from_number(ep.pattern), f"sim/{episode_name(ep.pattern, ep.variation)}",
+                             ep.joints, features(ep.images), features(ep.images_opposite)) for ep in episodes),
+                           source=f"simulated:{config.key()}")
 
 
 __all__ = ["DatasetConfig", "DATASET_PROFILES", "SMOKE_PATTERNS", "GenerationReport", "CorruptEpisodeError",

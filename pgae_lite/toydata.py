@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .data import MAX_STEPS, Pattern, PGAEDataset
+from .data import Pattern, PGAEDataset, from_recordings
 from .language import COLOURS
 
 
@@ -31,12 +31,11 @@ def toy_dataset(variations: int = 6, seed: int = 0, patterns: range | list[int] 
     motion = {"push": np.array([0.1, 0.2, 0.0, -0.15, 0.0]), "pull": np.array([-0.1, -0.2, 0.0, 0.15, 0.0]),
               "slide": np.array([0.0, 0.05, 0.2, 0.0, 0.1])}
     cube_motion = {"push": np.array([0.0, 0.1]), "pull": np.array([0.0, -0.1]), "slide": np.array([0.1, 0.0])}
-    rows: dict[str, list] = {k: [] for k in ("joints", "vision", "vision_opposite", "lengths", "descriptions",
-                                             "pattern", "is_test", "ids", "action", "arrangement")}
+    recordings = []
     for v in range(variations):
         for number in patterns:
             p = Pattern.from_number(number)
-            n = MAX_STEPS if p.speed == "slowly" else MAX_STEPS // 2
+            n = p.steps
             tau = np.linspace(0, 1, n)[:, None]
             start = np.array([0.5, 0.6, 0.5, 0.3, 0.5]) + rng.normal(0, 0.01, 5)
             go = _min_jerk(np.clip(2 * tau, 0, 1))           # reach the cube in the first half
@@ -55,18 +54,5 @@ def toy_dataset(variations: int = 6, seed: int = 0, patterns: range | list[int] 
             mirrored = np.concatenate([colour[:, ::-1], -right_pos, -left_pos, -hand], 1)
             vision = 1 / (1 + np.exp(-(scene @ camera.T))) + rng.normal(0, 0.01, (n, 30))
             opposite = 1 / (1 + np.exp(-(mirrored @ opposite_camera.T))) + rng.normal(0, 0.01, (n, 30))
-            pad = ((0, MAX_STEPS - n), (0, 0))
-            rows["joints"].append(np.pad(joints, pad))
-            rows["vision"].append(np.pad(vision, pad))
-            rows["vision_opposite"].append(np.pad(opposite, pad))
-            rows["lengths"].append(n)
-            rows["descriptions"].append(p.descriptions())
-            rows["pattern"].append(number)
-            rows["is_test"].append(p.is_test)
-            rows["ids"].append(f"toy{v}/pattern{number:03d}")
-            rows["action"].append(p.code)
-            rows["arrangement"].append(f"{p.left}+{p.right}")
-    arrays = {k: np.asarray(x) for k, x in rows.items()}
-    for k in ("joints", "vision", "vision_opposite"):
-        arrays[k] = arrays[k].astype(np.float32)
-    return PGAEDataset(**arrays, source=f"toy:seed={seed}")
+            recordings.append((p, f"toy{v}/pattern{number:03d}", joints, vision, opposite))
+    return from_recordings(recordings, source=f"toy:seed={seed}")
