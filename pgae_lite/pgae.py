@@ -34,6 +34,9 @@ class ModelConfig:
     layers: int = 2
     hidden: int = 50
     cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
+    # "predicted" = the paper's: the action decoder reads back its own joints;
+    # "start" = it reads the given start joints at every step (see ActionDecoder).
+    joint_feedback: str = "predicted"
 
     @property
     def state_dim(self) -> int:
@@ -124,7 +127,10 @@ class ActionDecoder(nn.Module):
 
     def __init__(self, cfg: ModelConfig):
         super().__init__()
+        if cfg.joint_feedback not in ("predicted", "start"):
+            raise ValueError(f"unknown joint_feedback {cfg.joint_feedback!r}; the options are: predicted, start")
         self.layers = cfg.layers
+        self.feedback = cfg.joint_feedback
         self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)
         self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
         self.out = nn.Linear(cfg.units, JOINT_DIM)
@@ -137,6 +143,13 @@ class ActionDecoder(nn.Module):
         decoder then stops computing a sample after its last step (outputs 0 there).
         """
         state = vector_to_state(self.init_state(h), self.layers)
+        if self.feedback == "start":
+            # Deviation from paper: the decoder reads the start joints at every step instead of
+            # its own predictions, so its small errors cannot feed back and grow, and training
+            # and test run the same single fused pass (no teacher forcing needed).
+            prev = start[:, None].expand(-1, vision.shape[1], -1)            # (B, S, 5)
+            y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
+            return torch.tanh(self.out(y))
         if teacher_joints is not None:                          # inputs ĵ_t := recorded j_t
             prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)   # (B, S, 5)
             y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
