@@ -115,24 +115,37 @@ def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str 
     return results, preds
 
 
-def format_table(results: dict[str, dict[str, dict[str, float]]], paper_rows: dict[str, str] | None = None) -> str:
+def format_table(results: dict[str, dict[str, dict[str, float]]], paper_rows: dict[str, str] | None = None,
+                 std: dict[str, dict[str, dict[str, float]]] | None = None) -> str:
     """Table 1 as text: each of our rows, followed by the paper's row it reproduces.
 
     ``results`` maps a row name (e.g. ``"PGAE (ours)"``) to :func:`evaluate`'s
-    first return value; ``paper_rows`` maps it to a row of :data:`PAPER_TABLE`.
+    first return value (or a mean over seeds); ``paper_rows`` maps it to a row of
+    :data:`PAPER_TABLE`; ``std``, if given, holds each cell's standard deviation
+    over seeds, printed as ``mean ± std``.
     """
     paper_rows = paper_rows or {}
+
+    def cell(name: str, signal: str, key: str, fmt: str) -> str:
+        value = format(results[name][signal][key], fmt)
+        if std is not None:
+            value += " ± " + format(std[name][signal][key], fmt)
+        return f"{value:>17s}"
+
     head = f"{'':26s}" + "".join(f"{s:>17s}" for s in TEST_SIGNALS)
     lines = ["Description accuracy (%)", head]
-    for name, res in results.items():
-        lines.append(f"{name:26s}" + "".join(f"{res[s]['accuracy']:17.2f}" for s in TEST_SIGNALS))
+    for name in results:
+        lines.append(f"{name:26s}" + "".join(cell(name, s, "accuracy", ".2f") for s in TEST_SIGNALS))
         if name in paper_rows:
             row = PAPER_TABLE[paper_rows[name]]
             lines.append(f"{'  paper ' + paper_rows[name]:26s}" + "".join(f"{row[s][0]:17.2f}" for s in TEST_SIGNALS))
-    lines += ["", "Joint nRMSE (%), valid steps [authors' padded convention]", head]
+    lines += ["", "Joint nRMSE (%), valid steps" + ("" if std else " [authors' padded convention]"), head]
     for name, res in results.items():
-        lines.append(f"{name:26s}" + "".join(
-            f"{res[s]['nrmse']:9.3f} [{res[s]['nrmse_padded']:5.3f}]" for s in TEST_SIGNALS))
+        if std is None:
+            lines.append(f"{name:26s}" + "".join(
+                f"{res[s]['nrmse']:9.3f} [{res[s]['nrmse_padded']:5.3f}]" for s in TEST_SIGNALS))
+        else:
+            lines.append(f"{name:26s}" + "".join(cell(name, s, "nrmse", ".3f") for s in TEST_SIGNALS))
         if name in paper_rows:
             row = PAPER_TABLE[paper_rows[name]]
             lines.append(f"{'  paper ' + paper_rows[name]:26s}" + "".join(f"{row[s][1]:17.2f}" for s in TEST_SIGNALS))

@@ -84,24 +84,27 @@ def signal_index(signal: str) -> int:
 def tokenize(text: str) -> list[str]:
     """Split user text into vocabulary words, leniently.
 
-    Case and extra spaces are ignored and two-word synonyms may be written with
-    a space (``move up``, ``greenish blue``). An unknown word raises
-    :class:`LanguageError` naming it and listing the vocabulary.
+    Case, punctuation and extra spaces are ignored and two-word synonyms may be
+    written with a space (``move up``, ``greenish blue``). Unknown words raise
+    :class:`LanguageError` naming every one of them and listing the vocabulary.
     """
-    words = str(text).lower().replace(BOS_EOS.lower(), " ").split()
+    words = re.sub(r"[.,;:!?]", " ", str(text).lower().replace(BOS_EOS.lower(), " ")).split()
     tokens: list[str] = []
+    unknown: list[str] = []
     i = 0
     while i < len(words):
         pair = "-".join(words[i:i + 2])
         if i + 1 < len(words) and pair in WORD_INDEX:
             tokens.append(pair)
             i += 2
-        elif words[i] in WORD_INDEX:
-            tokens.append(words[i])
-            i += 1
         else:
-            vocab = ", ".join(sorted(w for w in VOCABULARY if w != BOS_EOS))
-            raise LanguageError(f"unknown word {words[i]!r} in {text!r}; the vocabulary is: {vocab}")
+            (tokens if words[i] in WORD_INDEX else unknown).append(words[i])
+            i += 1
+    if unknown:
+        vocab = ", ".join(sorted(w for w in VOCABULARY if w != BOS_EOS))
+        listed = ", ".join(repr(w) for w in dict.fromkeys(unknown))
+        raise LanguageError(f"unknown word{'s' if len(set(unknown)) > 1 else ''} {listed} in {text!r}; "
+                            f"the vocabulary is: {vocab}")
     return tokens
 
 

@@ -37,6 +37,9 @@ class ModelConfig:
     # "predicted" = the paper's: the action decoder reads back its own joints;
     # "start" = it reads the given start joints at every step (see ActionDecoder).
     joint_feedback: str = "predicted"
+    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py).
+    language_encoder: str = "lstm"
+    pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
 
     @property
     def state_dim(self) -> int:
@@ -62,11 +65,27 @@ class LanguageEncoder(nn.Module):
         super().__init__()
         self.rnn = make_recurrent(cfg.cell, INPUT_DIM, cfg.units, cfg.layers)
         embedding_init_(self.rnn)
+        self.output_dim = cfg.state_dim
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         x = nn.functional.one_hot(tokens, INPUT_DIM).float()   # (B, 5, 28)
         _, state = self.rnn(x, lengths)
         return state_to_vector(state)                           # (B, 400)
+
+
+LANGUAGE_ENCODERS = ("lstm", "pretrained")
+
+
+def make_language_encoder(cfg: ModelConfig) -> nn.Module:
+    """The language encoder ``cfg.language_encoder`` names; it has an ``output_dim``."""
+    if cfg.language_encoder == "lstm":
+        return LanguageEncoder(cfg)
+    if cfg.language_encoder == "pretrained":
+        # Imported here: transformers loads only when PGAE-BERT is used.
+        from .pretrained import PretrainedLanguageEncoder
+        return PretrainedLanguageEncoder(cfg.pretrained_model)
+    raise ValueError(f"unknown language_encoder {cfg.language_encoder!r}; "
+                     f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
 
 
 class ActionEncoder(nn.Module):
@@ -123,6 +142,14 @@ class ActionDecoder(nn.Module):
     The visual features v_t are the recorded ones at every step (teacher-forced,
     as in the paper); the joints are the decoder's own previous predictions,
     or the recorded ones when ``teacher_joints`` is given (faster training).
+
+    One step at a time, e.g. to drive a robot that renders v_t as it moves
+    (:mod:`pgae_lite.closedloop`)::
+
+        state = decoder.begin(h)
+        j = start                                   # ĵ_0 = the start joints
+        for v_t in vision:                          # v_0, v_1, ...
+            j, state = decoder.step(state, v_t, j, start)   # ĵ_{t+1}
     """
 
     def __init__(self, cfg: ModelConfig):
@@ -135,6 +162,20 @@ class ActionDecoder(nn.Module):
         self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
         self.out = nn.Linear(cfg.units, JOINT_DIM)
 
+    def begin(self, h: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The LSTM's initial state (h, c), each (layers, B, units), from the shared representation h: W h + b."""
+        return vector_to_state(self.init_state(h), self.layers)
+
+    def step(self, state: tuple[torch.Tensor, torch.Tensor], v_t: torch.Tensor, j_t: torch.Tensor,
+             start: torch.Tensor) -> tuple[torch.Tensor, tuple[torch.Tensor, torch.Tensor]]:
+        """One step: v_t (B, 30), ĵ_t (B, 5), start joints (B, 5) -> ĵ_{t+1} (B, 5) and the new state.
+
+        With ``joint_feedback="start"`` the decoder reads ``start`` in place of ĵ_t.
+        """
+        joints_in = start if self.feedback == "start" else j_t
+        y, state = self.rnn.step(torch.cat([v_t, joints_in], 1), state)
+        return torch.tanh(self.out(y)), state
+
     def forward(self, h: torch.Tensor, vision: torch.Tensor, start: torch.Tensor,
                 teacher_joints: torch.Tensor | None = None, steps: torch.Tensor | None = None) -> torch.Tensor:
         """vision (B, S, 30), start (B, 5) -> joints of steps 1..S (B, S, 5).
@@ -142,7 +183,7 @@ class ActionDecoder(nn.Module):
         ``steps`` (B,), if given, is how many steps each sample needs: a free-running
         decoder then stops computing a sample after its last step (outputs 0 there).
         """
-        state = vector_to_state(self.init_state(h), self.layers)
+        state = self.begin(h)
         if self.feedback == "start":
             # Deviation from paper: the decoder reads the start joints at every step instead of
             # its own predictions, so its small errors cannot feed back and grow, and training
@@ -160,16 +201,15 @@ class ActionDecoder(nn.Module):
         order = torch.argsort(steps.cpu(), descending=True, stable=True)      # longest first
         active = (steps.cpu()[order][None] > torch.arange(S)[:, None]).sum(1).tolist()  # (S,) samples still running
         order = order.to(vision.device)
-        vision, j = vision[order], start[order]
+        vision, start = vision[order], start[order]
         state = (state[0][:, order], state[1][:, order])
-        outs = []
+        j, outs = start, []
         for t, v_t in enumerate(vision.unbind(1)):              # S x (B, 30)
             k = active[t]
             if k == 0:
                 break
             state = (state[0][:, :k], state[1][:, :k])
-            y, state = self.rnn.step(torch.cat([v_t[:k], j[:k]], 1), state)
-            j = torch.tanh(self.out(y))                         # ĵ_{t+1}, (k, 5)
+            j, state = self.step(state, v_t[:k], j[:k], start[:k])   # ĵ_{t+1}, (k, 5)
             outs.append(nn.functional.pad(j, (0, 0, 0, B - k)))
         joints = torch.stack(outs, 1)                           # (B, S', 5), S' <= S
         joints = nn.functional.pad(joints, (0, 0, 0, S - joints.shape[1]))
@@ -182,27 +222,38 @@ class PGAE(nn.Module):
     def __init__(self, cfg: ModelConfig | None = None):
         super().__init__()
         self.cfg = cfg or ModelConfig()
-        self.language_encoder = LanguageEncoder(self.cfg)
+        self.language_encoder = make_language_encoder(self.cfg)   # LSTM (PGAE) or frozen transformer (PGAE-BERT)
         self.action_encoder = ActionEncoder(self.cfg)
-        self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.cfg.state_dim, self.cfg.hidden)
+        self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden)
         self.language_decoder = LanguageDecoder(self.cfg)
         self.action_decoder = ActionDecoder(self.cfg)
 
-    def encode(self, batch: SignalBatch) -> tuple[torch.Tensor, torch.Tensor]:
-        """Shared representation h and GMU gate z, each (B, hidden)."""
-        f_lang = self.language_encoder(batch.lang_tokens, batch.lang_lengths)
+    def encode(self, batch: SignalBatch, language: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+        """Shared representation h and GMU gate z, each (B, hidden).
+
+        ``language`` (B, D), if given, replaces the language encoder's output, e.g. free text
+        through PGAE-BERT: ``model.language_encoder.encode_texts(["execute please push ..."])``.
+        """
+        if language is None:
+            f_lang = self.language_encoder(batch.lang_tokens, batch.lang_lengths)
+        else:
+            f_lang = language
+            if f_lang.shape != (len(batch.signal), self.language_encoder.output_dim):
+                raise ValueError(f"language features must be (batch, {self.language_encoder.output_dim}) = "
+                                 f"{(len(batch.signal), self.language_encoder.output_dim)}; got {tuple(f_lang.shape)}")
         f_act = self.action_encoder(batch.action_input, batch.action_lengths)
         return self.gmu(f_act, f_lang)
 
     def forward(self, batch: SignalBatch, teacher_language: bool = False,
                 teacher_joints: bool = False, feedback: str = "greedy",
-                joint_noise: float = 0.0) -> dict[str, torch.Tensor]:
+                joint_noise: float = 0.0, language: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
         """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden).
 
         With ``teacher_joints`` the action decoder reads the recorded joints, plus
         Gaussian noise of standard deviation ``joint_noise`` (training only).
+        ``language`` (B, D): precomputed language features in place of the encoder's (see :meth:`encode`).
         """
-        h, z = self.encode(batch)
+        h, z = self.encode(batch, language)
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
         teacher = None

@@ -8,7 +8,9 @@ earlier chapter (or ``python -m pgae_lite simulate``) already made:
 1. :func:`pgae_lite.simdata.generate` records the episodes;
 2. :func:`trained_cae` trains the CAE on frames of the training episodes only;
 3. :func:`simulated_dataset` encodes every frame of both views into 30
-   features and returns a :class:`~pgae_lite.data.PGAEDataset`.
+   features and returns a :class:`~pgae_lite.data.PGAEDataset`;
+4. :func:`trained_pgae` trains one of Table 1's models on it (PGAE, PGAE-BERT,
+   or the model of PGAE-self / PGAE-opposite), cached the same way.
 """
 from __future__ import annotations
 
@@ -17,11 +19,15 @@ import json
 import os
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .cae import (CAEConfig, ChannelSeparatedCAE, extract_features, get_cae_config, load_cae,
                   train_cae)
 from .data import DataFormatError, PGAEDataset
 from .simdata import DATASET_PROFILES, DatasetConfig, cache_dir, generate, to_dataset, training_frames
+
+if TYPE_CHECKING:
+    from .train import Trained
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 
@@ -80,4 +86,27 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
     return dataset
 
 
-__all__ = ["simulated_dataset", "trained_cae", "cae_path", "profile_name"]
+def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
+                 device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
+    """A model of Table 1 trained on the profile's simulated data: loaded from the cache if trained before.
+
+    ``training`` is one of :data:`pgae_lite.reproduce.TRAININGS` (``"PGAE"``,
+    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
+    ``train_overrides`` change the profile's training options (e.g. ``epochs=60``).
+    An interrupted training resumes from its last checkpoint.
+    """
+    from .config import get_profile
+    from .reproduce import TRAININGS, training_profile
+    from .train import train
+
+    if training not in TRAININGS:
+        raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
+    name = profile_name(profile)
+    dataset = simulated_dataset(name, device, progress)
+    prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
+    key = hashlib.sha1(json.dumps(prof.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+    folder = cache_dir() / "pgae" / f"{DATASET_PROFILES[name].key()}-{_key(get_cae_config(name))}-{training}-{key}"
+    return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+
+
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path", "profile_name"]

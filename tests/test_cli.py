@@ -15,7 +15,8 @@ from pgae_lite.__main__ import main
 from pgae_lite.language import TEST_SIGNALS
 
 ROOT = Path(__file__).resolve().parents[1]
-OPTIONS = ("--original-data", "--profile", "--seed", "--epochs", "--out", "--device", "--no-progress")
+OPTIONS = ("--original-data", "--profile", "--rows", "--seed", "--seeds", "--pretrained-model", "--epochs", "--out",
+           "--device", "--no-progress")
 
 
 def run(*args, env=None, timeout=300):
@@ -33,6 +34,8 @@ def test_help():
     for profile in ("smoke", "book", "paper"):
         assert profile in rep.stdout
     assert "PGAE_ORIGINAL_DATA" in rep.stdout and "PGAE_LITE_PROFILE" in rep.stdout
+    for row in ("PGAE-BERT", "PGAE-self", "PGAE-opposite"):
+        assert row in rep.stdout
 
 
 def test_top_level_help(capsys):
@@ -50,15 +53,22 @@ def test_missing_data_path(tmp_path):
     assert "Traceback" not in r.stderr
 
 
-def _check_outputs(out: Path, original) -> dict:
+def _check_outputs(out: Path, original, row: str = "PGAE", seeds: tuple[int, ...] = (0,)) -> dict:
     report = json.loads((out / "results.json").read_text())
-    assert report["profile"]["name"] == "smoke" and report["seed"] == 0
-    assert report["wall_seconds"] > 0 and report["train_seconds"] > 0
-    assert list(report["results"]) == list(TEST_SIGNALS)
+    assert report["profile"] == "smoke" and report["seeds"] == list(seeds)
+    assert report["wall_seconds"] > 0
+    for info in report["trainings"].values():
+        assert set(info["train_seconds"]) == {str(s) for s in seeds}
+        assert all(t > 0 for t in info["train_seconds"].values())
+    cells = report["rows"][row]
+    for seed in seeds:
+        assert list(cells["seeds"][str(seed)]) == list(TEST_SIGNALS)
     for signal in TEST_SIGNALS:
-        cell = report["results"][signal]
-        assert 0 <= cell["accuracy"] <= 100 and cell["nrmse"] > 0 and cell["n"] == 216
-        assert set(report["paper"][signal]) == {"accuracy", "nrmse"}
+        for seed in seeds:
+            cell = cells["seeds"][str(seed)][signal]
+            assert 0 <= cell["accuracy"] <= 100 and cell["nrmse"] > 0 and cell["n"] == 216
+        assert set(cells["paper"][signal]) == {"accuracy", "nrmse"}
+        assert set(cells["mean"][signal]) == set(cells["std"][signal]) == {"accuracy", "nrmse", "nrmse_padded"}
 
     with np.load(out / "predictions.npz", allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
@@ -82,9 +92,11 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
     r = run("reproduce", "--original-data", original_data, "--out", out, "--no-progress", "--device", "cpu")
     assert r.returncode == 0, r.stderr
     assert "93.05" in r.stdout and "paper PGAE" in r.stdout            # Table 1 beside the paper's row
-    assert {p.name for p in out.iterdir()} == {"checkpoint.pt", "results.json", "predictions.npz"}
+    assert {p.name for p in out.iterdir()} == {"PGAE-seed0", "results.json", "predictions.npz"}
+    assert {p.name for p in (out / "PGAE-seed0").iterdir()} == {"checkpoint.pt", "predictions-PGAE.npz"}
+    assert (out / "predictions.npz").read_bytes() == (out / "PGAE-seed0" / "predictions-PGAE.npz").read_bytes()
     first = _check_outputs(out, original)
-    checkpoint = (out / "checkpoint.pt").read_bytes()
+    checkpoint = (out / "PGAE-seed0" / "checkpoint.pt").read_bytes()
 
     # A second run in the same folder finds the finished checkpoint: no training, same results.
     # (In this process, with the already-loaded data, to keep the suite fast: same code path.)
@@ -92,14 +104,13 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
     monkeypatch.setattr("pgae_lite.data.load_original", lambda path: original)
     assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--no-progress",
                  "--device", "cpu"]) == 0
-    assert (out / "checkpoint.pt").read_bytes() == checkpoint           # no epoch was run again
+    assert (out / "PGAE-seed0" / "checkpoint.pt").read_bytes() == checkpoint  # no epoch was run again
     second = _check_outputs(out, original)
-    assert second["results"] == first["results"]
-    assert second["final_loss"] == first["final_loss"]
+    assert second["rows"] == first["rows"]
     capsys.readouterr()
 
-    # Another seed in the same folder is refused with a clear message.
-    assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--seed", "1",
+    # Another recipe in the same folder is refused with a clear message.
+    assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--epochs", "4",
                  "--no-progress", "--device", "cpu"]) == 2
     assert "different profile" in capsys.readouterr().err
 
@@ -118,7 +129,45 @@ def test_simulate_and_reproduce_on_simulated_data(smoke_episodes, tmp_path, monk
         assert {k for k in z.files} == {f"{s.replace(' ', '_')}_{part}" for s in TEST_SIGNALS
                                         for part in ("ids", "text", "joints")}
         ids = z["execute_ids"]
-    assert len(ids) == report["results"]["execute"]["n"] and all(i.startswith("sim/") for i in ids)
+    assert len(ids) == report["rows"]["PGAE"]["seeds"]["0"]["execute"]["n"] and all(i.startswith("sim/") for i in ids)
+
+
+def test_reproduce_self_and_opposite_rows_over_two_seeds(original_data, original, tmp_path, monkeypatch, capsys):
+    """One model trained on both views gives two rows; two seeds give mean ± std of every cell."""
+    monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
+    monkeypatch.setattr("pgae_lite.data.load_original", lambda path: original)
+    out = tmp_path / "views"
+    assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--rows",
+                 "pgae-self,PGAE-opposite", "--seeds", "2", "--no-progress", "--device", "cpu"]) == 0
+    printed = capsys.readouterr().out
+    assert "80.56" in printed and "65.28" in printed and "±" in printed      # both paper rows, mean ± std
+    assert {p.name for p in out.iterdir()} == {"PGAE-views-seed0", "PGAE-views-seed1", "results.json",
+                                               "predictions.npz"}
+    for seed in (0, 1):
+        assert {p.name for p in (out / f"PGAE-views-seed{seed}").iterdir()} == {
+            "checkpoint.pt", "predictions-PGAE-self.npz", "predictions-PGAE-opposite.npz"}
+    report = _check_outputs(out, original, "PGAE-opposite", seeds=(0, 1))
+    _check_outputs(out, original, "PGAE-self", seeds=(0, 1))
+    assert report["trainings"]["PGAE-views"]["profile"]["train"]["opposite_prob"] == 0.5
+    rows = report["rows"]
+    for seed in ("0", "1"):
+        for shared in ("execute", "repeat language"):           # no action shown: the same cells
+            assert rows["PGAE-opposite"]["seeds"][seed][shared] == rows["PGAE-self"]["seeds"][seed][shared]
+        assert rows["PGAE-opposite"]["seeds"][seed]["describe"] != rows["PGAE-self"]["seeds"][seed]["describe"]
+    cells = [rows["PGAE-self"]["seeds"][s]["describe"]["nrmse"] for s in ("0", "1")]
+    assert rows["PGAE-self"]["mean"]["describe"]["nrmse"] == pytest.approx(np.mean(cells))
+    assert rows["PGAE-self"]["std"]["describe"]["nrmse"] == pytest.approx(np.std(cells, ddof=1))
+
+
+def test_unknown_row_and_bad_seed_count_are_clear_errors(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["reproduce", "--rows", "PGAE,GPT"])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "'GPT'" in err and "PGAE-BERT" in err and "PGAE-opposite" in err
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--seeds", "0"])
+    assert "at least 1" in capsys.readouterr().err
 
 
 def test_cli_profile_names_match_the_package():
