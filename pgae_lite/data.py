@@ -130,6 +130,14 @@ class Normaliser:
         lo, hi = lo_hi
         return (2.0 * (x - lo) / (hi - lo) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
 
+    def joints_to_model(self, x: np.ndarray) -> np.ndarray:
+        """Joints in the data's own units -> the model's [-1, 1]."""
+        return self._scale(x, self.joints)
+
+    def vision_to_model(self, x: np.ndarray, opposite: bool = False) -> np.ndarray:
+        """Visual features (NICO's view, or the opposite agent's) -> the model's [-1, 1]."""
+        return self._scale(x, self.vision_opposite if opposite else self.vision)
+
     def joints_to_data(self, x: np.ndarray | torch.Tensor) -> np.ndarray | torch.Tensor:
         """Inverse of the joint scaling: [-1, 1] -> the data's own units."""
         lo, hi = self.joints
