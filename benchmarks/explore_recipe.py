@@ -26,6 +26,7 @@ ap.add_argument("--set", nargs="*", default=[], help="TrainConfig overrides key=
 ap.add_argument("--model", nargs="*", default=[], help="ModelConfig overrides key=value")
 ap.add_argument("--sim", action="store_true", help="the simulated data (book profile) instead of the authors'")
 ap.add_argument("--log", default=None)
+ap.add_argument("--save", default=None, help="folder for the checkpoint (default: none saved)")
 a = ap.parse_args()
 torch.set_num_threads(a.threads)
 def overrides(pairs):
@@ -49,7 +50,7 @@ def cb(epoch, model, rec):
     rows.append(line)
     print(json.dumps(line), flush=True)
 
-tr = train(ds, prof, progress=False, callback=cb)
+tr = train(ds, prof, out_dir=a.save, progress=False, callback=cb)
 print("train seconds", round(tr.seconds))
 if a.log:
     Path(a.log).write_text(json.dumps({"argv": vars(a), "train_seconds": tr.seconds, "rows": rows}))
