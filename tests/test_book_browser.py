@@ -1,0 +1,240 @@
+"""Open the built book in a real headless browser, offline, page by page.
+
+For every page in ``_toc.yml`` this checks what a reader would see in
+``_build/html`` served from localhost in Debian's Chromium (driven by Playwright
+for Python, with the system browser: no ``playwright install``):
+
+- nothing is fetched from anywhere but localhost (every other request is
+  aborted and reported): the book renders offline;
+- no console errors and no uncaught JavaScript exceptions;
+- every image has loaded (``naturalWidth > 0``);
+- every formula is typeset by MathJax (no raw TeX left, no MathJax errors);
+- no executed cell shows an error (traceback or ``Traceback`` on stderr);
+- saved widgets and matplotlib animations are drawn;
+- every link to a page of the book (navigation, sidebar, prev/next, text)
+  answers HTTP 200.
+
+A full-page screenshot of each page goes to ``_build/screenshots/`` with a
+``report.json`` of what was found and how long each page took. The module is
+skipped when the book has not been built, or (unless
+``PGAE_BROWSER_REQUIRED=1``, as in ``.ci/test``) when Chromium or Playwright is
+missing. Run it after ``jupyter-book build .``:
+``python -m pytest tests/test_book_browser.py``.
+"""
+from __future__ import annotations
+
+import functools
+import json
+import os
+import re
+import shutil
+import threading
+import time
+import urllib.error
+import urllib.request
+from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
+from pathlib import Path
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+BOOK = ROOT / "_build" / "html"
+SCREENSHOTS = ROOT / "_build" / "screenshots"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+# Flags for Chromium as root on a machine without network: no sandbox, no GPU, none
+# of its background traffic (updates, sync, first-run pages), no proxy between it and
+# localhost. Playwright gives every launch a fresh temporary profile (--user-data-dir).
+CHROMIUM_FLAGS = [
+    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync",
+    "--no-proxy-server",
+]
+# Console errors we accept, each with the reason.
+KNOWN_CONSOLE_ERRORS = [
+    # sphinx-thebe 0.3.1 declares THEBE_JS_URL twice on every page: harmless, the live
+    # code button still works (the thebe library itself is fetched only when clicked).
+    re.compile(r"Identifier 'THEBE_JS_URL' has already been declared"),
+]
+
+
+def _missing_browser() -> str | None:
+    if not Path(CHROMIUM).exists():
+        return f"no Chromium at {CHROMIUM} (apt-get install chromium)"
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        return "Playwright for Python is not installed (pip install playwright)"
+    return None
+
+
+if not (BOOK / "index.html").exists():
+    pytest.skip(f"no built book in {BOOK}: run `jupyter-book build .` first", allow_module_level=True)
+if (_why := _missing_browser()) is not None:
+    if os.environ.get("PGAE_BROWSER_REQUIRED") == "1":  # as in .ci/test: fail, don't skip
+        raise RuntimeError(_why)
+    pytest.skip(_why, allow_module_level=True)
+
+from playwright.sync_api import sync_playwright
+
+
+def toc_pages() -> list[str]:
+    """Every page of _toc.yml, in reading order, as paths without suffix."""
+    toc = yaml.safe_load((ROOT / "_toc.yml").read_text(encoding="utf-8"))
+    pages = [toc["root"]]
+
+    def walk(entries):
+        for entry in entries or []:
+            if "file" in entry:
+                pages.append(entry["file"])
+            walk(entry.get("sections"))
+            walk(entry.get("chapters"))
+
+    walk(toc.get("parts", []) + toc.get("chapters", []) + toc.get("sections", []))
+    return pages
+
+
+PAGES = toc_pages()
+REPORT: dict[str, dict] = {}
+
+
+@pytest.fixture(scope="module")
+def site():
+    """The built book served on a free localhost port, in a thread."""
+    handler = functools.partial(_QuietHandler, directory=str(BOOK))
+    server = _QuietServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    yield f"http://127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    (SCREENSHOTS / "report.json").write_text(json.dumps(REPORT, indent=1), encoding="utf-8")
+
+
+class _QuietHandler(SimpleHTTPRequestHandler):
+    def log_message(self, *args):  # keep pytest's output readable
+        pass
+
+
+class _QuietServer(ThreadingHTTPServer):
+    def handle_error(self, request, client_address):
+        pass  # the browser drops connections it no longer needs (broken pipes): not a failure
+
+
+@pytest.fixture(scope="module")
+def browser():
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+        yield browser
+        browser.close()
+
+
+DIRECT = urllib.request.build_opener(urllib.request.ProxyHandler({}))  # localhost: no proxy
+
+
+@functools.cache
+def http_status(url: str) -> int:
+    try:
+        with DIRECT.open(url, timeout=10) as response:
+            return response.status
+    except urllib.error.HTTPError as error:
+        return error.code
+
+
+# Run in the page once it has loaded: wait for the images, then look at what it shows.
+INSPECT = r"""async () => {
+  // Images below the fold may be lazy: load them all, then wait for each.
+  const imgs = [...document.images];
+  imgs.forEach(img => { img.loading = "eager"; });
+  await Promise.all(imgs.map(img => img.complete ? null
+      : new Promise(done => { img.onload = img.onerror = done; })));
+  // MathJax (deferred script) typesets once at start-up: wait for it.
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) await MathJax.startup.promise;
+  const main = document.querySelector("main") || document.body;
+  // Text outside code, formulas and scripts, where raw TeX would show.
+  const texts = [];
+  const walker = document.createTreeWalker(main, NodeFilter.SHOW_TEXT, {acceptNode: n =>
+      n.parentElement.closest("pre, code, script, style, textarea, mjx-container, .highlight")
+        ? NodeFilter.FILTER_REJECT : NodeFilter.FILTER_ACCEPT});
+  while (walker.nextNode()) texts.push(walker.currentNode.textContent);
+  return {
+    images: imgs.length,
+    brokenImages: imgs.filter(i => !(i.complete && i.naturalWidth > 0))
+                      .map(i => i.currentSrc || i.src),
+    formulas: document.querySelectorAll(".math").length,
+    untypeset: [...document.querySelectorAll(".math")]
+        .filter(m => !m.querySelector("mjx-container")).map(m => m.textContent.slice(0, 80)),
+    // A TeX error shows as mjx-merror; an undefined macro as its name in red (MathJax's
+    // noundefined extension): the textContent of either is the faulty TeX.
+    mathErrors: [...document.querySelectorAll('mjx-merror, mjx-mtext[style*="color: red"]')]
+        .map(m => m.closest("mjx-container").parentElement.textContent.slice(0, 80)),
+    text: texts.join(" "),
+    errorOutputs: [...main.querySelectorAll(".output.error, .output.traceback")]
+        .map(e => e.textContent.slice(0, 300)),
+    stderr: [...main.querySelectorAll(".output.stderr")].map(e => e.textContent.slice(0, 300)),
+    widgetViews: main.querySelectorAll('script[type="application/vnd.jupyter.widget-view+json"]').length,
+    // The widget manager draws each saved view into a .widget-subarea beside its tag.
+    widgetsDrawn: main.querySelectorAll(".widget-subarea .jupyter-widgets").length,
+    widgetAreas: main.querySelectorAll(".widget-subarea").length,
+    animations: main.querySelectorAll(".animation").length,
+    animationIcons: main.querySelectorAll(".animation .anim-buttons svg").length,
+    links: [...document.querySelectorAll("a[href]")].map(a => a.href),
+  };
+}"""
+# Raw TeX that MathJax should have replaced: \( \) \[ \] $$, $x$ and \begin{...}.
+RAW_TEX = re.compile(r"\\\(|\\\)|\\\[|\\\]|\$\$|\$[^\s$][^$\n]{0,200}?[^\s$\\]\$|\\begin\{")
+
+
+@pytest.mark.parametrize("docname", PAGES)
+def test_page_renders_offline(docname, site, browser):
+    started = time.perf_counter()
+    found: dict[str, list] = {"external_requests": [], "console_errors": [], "http_errors": []}
+    context = browser.new_context(viewport={"width": 1280, "height": 900})
+
+    def route(route):  # the book must render offline: only localhost may be asked
+        if route.request.url.startswith(site):
+            route.continue_()
+        else:
+            found["external_requests"].append(route.request.url)
+            route.abort()
+
+    context.route("**/*", route)
+    page = context.new_page()
+    page.on("console", lambda msg: msg.type == "error" and found["console_errors"].append(msg.text))
+    page.on("pageerror", lambda exc: found["console_errors"].append(f"uncaught: {exc}"))
+    page.on("response", lambda r: r.status >= 400 and found["http_errors"].append(f"{r.status} {r.url}"))
+
+    response = page.goto(f"{site}/{docname}.html", wait_until="load")
+    assert response is not None and response.status == 200, f"{docname}.html: {response and response.status}"
+    seen = page.evaluate(INSPECT)
+    page.wait_for_timeout(300)  # let late console messages (fonts, widgets) arrive
+    checked = time.perf_counter()
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=str(SCREENSHOTS / f"{docname.replace('/', '_')}.png"), full_page=True)
+    screenshot_seconds = time.perf_counter() - checked
+    context.close()
+
+    known = [e for e in found["console_errors"] if any(p.search(e) for p in KNOWN_CONSOLE_ERRORS)]
+    found["console_errors"] = [e for e in found["console_errors"] if e not in known]
+    found["broken_images"] = seen["brokenImages"]
+    found["untypeset_formulas"] = seen["untypeset"] + seen["mathErrors"]
+    found["raw_tex"] = [m.group(0) for m in RAW_TEX.finditer(seen["text"])]
+    found["error_outputs"] = seen["errorOutputs"] + [s for s in seen["stderr"] if "Traceback" in s]
+    found["widgets_not_drawn"] = ([f"{seen['widgetViews']} saved widget views, {seen['widgetAreas']} drawn"]
+                                  if seen["widgetViews"] > min(seen["widgetAreas"], seen["widgetsDrawn"]) else [])
+    found["animations_without_icons"] = (["animation buttons have no icons"]
+                                         if seen["animations"] and not seen["animationIcons"] else [])
+    # Links into the book (navigation, prev/next, cross-references) must lead to a page.
+    internal = {link.split("#")[0] for link in seen["links"] if link.startswith(site)}
+    found["broken_links"] = sorted(url for url in internal if http_status(url) != 200)
+
+    REPORT[docname] = {
+        "seconds": round(time.perf_counter() - started, 2),
+        "screenshot_seconds": round(screenshot_seconds, 2),
+        "known_console_errors": known,
+        "formulas": seen["formulas"], "images": seen["images"],
+        "widget_views": seen["widgetViews"], "animations": seen["animations"],
+        "stderr_outputs": seen["stderr"], "internal_links": len(internal),
+        **found,
+    }
+    problems = {k: v for k, v in found.items() if v}
+    assert not problems, f"{docname}: " + json.dumps(problems, indent=1)
