@@ -33,6 +33,15 @@ replay then passes 216 of 216. ``tracking=False`` sends ĵ_t as it is (what
 :func:`open_loop` executes a joint trajectory computed in advance (e.g. the
 paper's execute, from :func:`pgae_lite.evaluate.predict`) the same way;
 :func:`compare` runs both over a set of episodes.
+
+Free-form instructions (paper, Sec. 3 and 5: PGAE-BERT "has the potential to
+recognise unseen natural language"). :func:`execute_paraphrases` gives every
+test episode one of the held-out paraphrases of its own instruction
+(:mod:`pgae_lite.paraphrases`, e.g. "Could you shove the crimson cube forward
+in a hurry" for "push red fast") and executes it both ways, through
+:func:`instruction_features` (PGAE-BERT's transformer reads any text; PGAE's
+LSTM only its vocabulary, and says which words it does not know) and
+:func:`paper_execute` (the open loop with those features).
 """
 from __future__ import annotations
 
@@ -48,9 +57,11 @@ from tqdm.auto import tqdm
 from .cae import ChannelSeparatedCAE, extract_features
 from .data import ACTION_SIDES, ARRANGEMENTS, Normaliser, Pattern, PGAEDataset, description_text
 from .evaluate import predict
-from .language import WORD_INDEX, parse_description, tokenize
+from .language import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
+from .paraphrases import Paraphrase, load_paraphrases
 from .pgae import PGAE
-from .signals import SignalBatch, make_batch, signal_ids
+from .pretrained import input_text
+from .signals import EOS, SIGNAL_TOKEN, SignalBatch, make_batch, signal_ids
 from .sim.actions import ActionCheck
 from .sim.record import Simulation
 from .sim.robot import HOME_POSE
@@ -217,6 +228,39 @@ def _nrmse(pred: np.ndarray, target: np.ndarray, length: int, joint_range: float
     return 100 * float(np.sqrt(np.mean(err ** 2))) / joint_range
 
 
+def _spread(n: int, limit: int | None) -> np.ndarray:
+    """Indices 0..n-1, or ``limit`` of them evenly spread."""
+    rows = np.arange(n)
+    if limit is not None and limit < n:
+        rows = rows[np.linspace(0, n, limit, endpoint=False).astype(int)]
+    return rows
+
+
+def _execute_episode(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, episodes: PGAEDataset,
+                     i: int, planned: np.ndarray, text: str, joint_range: float, *,
+                     language: torch.Tensor | None = None, closed: bool = True,
+                     config: DatasetConfig | None = None, tracking: bool = True) -> dict:
+    """Episode ``i`` of ``episodes`` executed open loop (``planned`` joints, (T, 5)) and closed loop: a table row.
+
+    ``text`` is what the model was told; ``language`` (1, D), if given, its features (see :func:`closed_loop`).
+    """
+    pattern, variation, length = int(episodes.pattern[i]), _variation(episodes.ids[i]), int(episodes.lengths[i])
+    pat, recorded = Pattern.from_number(pattern), episodes.joints[i]
+    row = {"id": episodes.ids[i], "pattern": pattern, "variation": variation, "action": pat.action,
+           "side": pat.side, "speed": pat.speed, "description": text}
+    t0 = time.perf_counter()
+    opened = open_loop(planned[:length], pattern, variation, description=text, config=config, tracking=tracking)
+    row.update(open_passed=opened.passed, open_nrmse=_nrmse(opened.joints, recorded, length, joint_range),
+               open_reason=opened.check.reason, open_seconds=time.perf_counter() - t0)
+    if closed:
+        t0 = time.perf_counter()
+        run = closed_loop(model, cae, normaliser, pattern, variation, text, config=config, tracking=tracking,
+                          language=language)
+        row.update(closed_passed=run.passed, closed_nrmse=_nrmse(run.joints, recorded, length, joint_range),
+                   closed_reason=run.check.reason, closed_seconds=time.perf_counter() - t0)
+    return row
+
+
 def compare(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
             split: str = "test", *, limit: int | None = None, config: DatasetConfig | None = None,
             tracking: bool = True, progress: bool = True) -> pd.DataFrame:
@@ -230,39 +274,112 @@ def compare(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data:
     """
     subset = data.split(split)
     pred = predict(model, subset, normaliser, "execute")          # open loop: recorded vision at every step
-    rows = np.arange(len(subset))
-    if limit is not None and limit < len(rows):
-        rows = rows[np.linspace(0, len(rows), limit, endpoint=False).astype(int)]
     joint_range = data.joint_range()
-    table = []
-    for i in tqdm(rows, desc="open vs closed loop", unit="ep", disable=not progress):
-        pattern, variation, length = int(subset.pattern[i]), _variation(subset.ids[i]), int(subset.lengths[i])
-        pat, recorded = Pattern.from_number(pattern), subset.joints[i]
-        text = description_text(subset.descriptions[i, i % 8])
-        t0 = time.perf_counter()
-        opened = open_loop(pred.joints[i, :length], pattern, variation, description=text, config=config,
-                           tracking=tracking)
-        t1 = time.perf_counter()
-        closed = closed_loop(model, cae, normaliser, pattern, variation, text, config=config, tracking=tracking)
-        t2 = time.perf_counter()
-        table.append({
-            "id": subset.ids[i], "pattern": pattern, "variation": variation, "action": pat.action,
-            "side": pat.side, "speed": pat.speed, "description": text,
-            "open_passed": opened.passed, "closed_passed": closed.passed,
-            "open_nrmse": _nrmse(opened.joints, recorded, length, joint_range),
-            "closed_nrmse": _nrmse(closed.joints, recorded, length, joint_range),
-            "open_reason": opened.check.reason, "closed_reason": closed.check.reason,
-            "open_seconds": t1 - t0, "closed_seconds": t2 - t1})
-    return pd.DataFrame(table)
+    return pd.DataFrame([
+        _execute_episode(model, cae, normaliser, subset, i, pred.joints[i],
+                         description_text(subset.descriptions[i, i % 8]), joint_range,
+                         config=config, tracking=tracking)
+        for i in tqdm(_spread(len(subset), limit), desc="open vs closed loop", unit="ep", disable=not progress)])
+
+
+# --------------------------------------------------------------------------- free-form instructions
+@torch.no_grad()
+def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
+    """Instructions -> the language encoder's features under ``execute``, (B, D), for ``language=``.
+
+    PGAE-BERT's pretrained encoder reads any text, after the signal phrase
+    (``input_text("execute", text)``, as in training). PGAE's LSTM reads only
+    its vocabulary: every text must be a description (action colour speed),
+    else a :class:`~pgae_lite.language.LanguageError` names the unknown words.
+    """
+    encoder = model.language_encoder
+    if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
+        return encoder.encode_texts([input_text("execute", t) for t in texts])
+    for t in texts:
+        try:
+            parse_description(t)
+        except LanguageError as e:
+            raise LanguageError(f"PGAE's LSTM language encoder reads only its vocabulary, in the order "
+                                f"action colour speed (PGAE-BERT reads free text): {e}") from e
+    device = next(model.parameters()).device
+    tokens = torch.tensor([[SIGNAL_TOKEN + signal_index("execute"), *(WORD_INDEX[w] for w in tokenize(t)), EOS]
+                           for t in texts], device=device)                                   # (B, 5)
+    return encoder(tokens, torch.full((len(texts),), 5, device=device))
+
+
+@torch.no_grad()
+def paper_execute(model: PGAE, episodes: PGAEDataset, normaliser: Normaliser, language: torch.Tensor,
+                  batch_size: int = 256) -> np.ndarray:
+    """The paper's execute (open loop: the recorded vision at every step) with language features (N, D).
+
+    :func:`~pgae_lite.evaluate.predict`'s ``execute`` with ``language`` in place of
+    the descriptions: joints (N, T, 5) in data units, step 0 = the start joints,
+    NaN past each episode's length.
+    """
+    model.eval()
+    device = next(model.parameters()).device
+    tensors, out = normaliser.tensors(episodes, device), []
+    for s in range(0, len(episodes), batch_size):
+        index = torch.arange(s, min(len(episodes), s + batch_size))
+        batch = make_batch(tensors, index, signal_ids("execute", len(index)), torch.zeros_like(index))
+        joints = model(batch, language=language[s:s + len(index)].to(device))["joints"]   # (B, T-1, 5)
+        out.append(normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], joints], 1)).cpu().numpy())
+    return np.where(episodes.mask[..., None], np.concatenate(out), np.nan).astype(np.float32)
+
+
+def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
+    """The paraphrase an episode is given: of its pattern's meaning, number ``variation`` mod how many there are.
+
+    With the 3 paraphrases per test instruction and 6 variations, each is used twice.
+    None: no paraphrase has that meaning.
+    """
+    pat = Pattern.from_number(pattern)
+    mine = [p for p in paraphrases if p.meaning == (pat.action, pat.colour, pat.speed)]
+    return mine[variation % len(mine)] if mine else None
+
+
+def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
+                        paraphrases: list[Paraphrase] | None = None, split: str = "test", *,
+                        limit: int | None = None, closed: bool = True, config: DatasetConfig | None = None,
+                        tracking: bool = True, progress: bool = True) -> pd.DataFrame:
+    """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
+
+    Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
+    :func:`~pgae_lite.paraphrases.load_paraphrases`) is told one
+    (:func:`paraphrase_of`), encoded by :func:`instruction_features`: PGAE-BERT
+    reads it, PGAE's LSTM raises a LanguageError naming the unknown words before
+    anything runs. Then, as in :func:`compare`: the paper's execute
+    (:func:`paper_execute`) run in the simulator (``open_*`` columns) and, if
+    ``closed``, :func:`closed_loop` (``closed_*``). nRMSE (%) is against the
+    recorded joints of the episode, the intended action. ``limit``: that many
+    episodes, evenly spread.
+    """
+    paraphrases = load_paraphrases() if paraphrases is None else paraphrases
+    subset = data.split(split)
+    told = [paraphrase_of(int(p), _variation(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
+    rows = np.flatnonzero([t is not None for t in told])
+    if not len(rows):
+        raise ValueError(f"no paraphrase has the meaning of any {split} episode")
+    rows = rows[_spread(len(rows), limit)]
+    episodes, told = subset.subset(rows), [told[i] for i in rows]
+    language = instruction_features(model, [t.text for t in told])          # (N, D)
+    planned = paper_execute(model, episodes, normaliser, language)
+    joint_range = data.joint_range()
+    return pd.DataFrame([
+        {**_execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
+                            language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
+         "meaning": " ".join(told[k].meaning)}
+        for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
 
 
 def success_summary(table: pd.DataFrame) -> pd.DataFrame:
-    """Success rate (%) and mean nRMSE (%) of both loops: over all episodes, per action and per speed."""
+    """Success rate (%) and mean nRMSE (%) of each loop in the table: over all, per action and per speed."""
     groups = [("all", table)] + [(name, g) for key in ("action", "speed") for name, g in table.groupby(key, sort=False)]
+    loops = [loop for loop in ("open", "closed") if f"{loop}_passed" in table]
     return pd.DataFrame([{
         "group": name, "n": len(g),
-        "open loop %": 100 * g["open_passed"].mean(), "closed loop %": 100 * g["closed_passed"].mean(),
-        "open nRMSE %": g["open_nrmse"].mean(), "closed nRMSE %": g["closed_nrmse"].mean()}
+        **{f"{loop} loop %": 100 * g[f"{loop}_passed"].mean() for loop in loops},
+        **{f"{loop} nRMSE %": g[f"{loop}_nrmse"].mean() for loop in loops}}
         for name, g in groups]).set_index("group")
 
 
@@ -290,4 +407,5 @@ def animate(rollout: Rollout, every: int = 2, fps: float = 10.0, size: float = 2
 
 
 __all__ = ["Rollout", "closed_loop", "open_loop", "compare", "success_summary", "execute_batch", "words_of",
-           "pattern_for", "animate", "POSITION_GAIN"]
+           "pattern_for", "animate", "POSITION_GAIN", "instruction_features", "paper_execute", "paraphrase_of",
+           "execute_paraphrases"]

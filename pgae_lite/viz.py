@@ -553,3 +553,179 @@ def plot_feature_rows(frames: Mapping[str, np.ndarray], features: np.ndarray | t
 
 __all__ += ["CHANNEL_COLOURS", "plot_channels", "plot_reconstructions", "plot_cae_history", "plot_features_over_time",
             "plot_feature_rows"]
+
+
+# --------------------------------------------------------------------------- variants: models, views, embeddings
+# Helpers of the PGAE-BERT and opposite-agent chapters (05, 06): training curves and
+# gates of several models side by side, which words a model confuses, and maps of
+# sentence embeddings.
+
+#: A display colour for each colour word of the dataset (canonical words).
+WORD_COLOURS: dict[str, str] = {"red": "tab:red", "green": "tab:green", "blue": "tab:blue", "yellow": "gold",
+                                "cyan": "darkturquoise", "violet": "darkviolet"}
+
+
+def plot_histories(histories: Mapping[str, Sequence[Mapping]],
+                   keys: Sequence[str] = ("language_loss", "action_loss")) -> Figure:
+    """Training curves of several runs on shared axes: one panel per loss, one line per run.
+
+    ``histories`` maps a run's name to its ``Trained.history``, e.g.
+    ``{"PGAE": pgae.history, "PGAE-BERT": bert.history}``; ``keys`` are the
+    history's loss entries to draw (log scale).
+    """
+    titles = {"loss": "total loss", "language_loss": "language loss (weighted CE)", "action_loss": "action loss (MSE)"}
+    fig, axes = plt.subplots(1, len(keys), figsize=(5.5 * len(keys), 3.4), squeeze=False)
+    for ax, key in zip(axes[0], keys):
+        for k, (name, history) in enumerate(histories.items()):
+            epochs = [r["epoch"] for r in history]
+            ax.plot(epochs, [r[key] for r in history], color=f"C{k}", label=name,
+                    marker="." if len(epochs) < 10 else None)
+        ax.set(yscale="log", xlabel="epoch", ylabel="training loss", title=titles.get(key, key))
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.legend(fontsize="small")
+    fig.tight_layout()
+    return fig
+
+
+def plot_mean_gates(groups: Mapping[str, Mapping[str, np.ndarray | torch.Tensor]],
+                    title: str = "Mean GMU gate per signal") -> Figure:
+    """Mean GMU gate per signal for several models or views, as grouped bars (± one standard deviation).
+
+    ``groups`` maps a group name (a model, a view) to ``{signal: gate values (N, hidden)}``,
+    e.g. ``{"PGAE": {s: p.gate for s, p in preds.items()}, ...}``; a signal missing
+    from a group leaves a gap. The spread is that of the per-sample mean gate.
+    z near 1 lets the action features through, z near 0 the language features.
+    """
+    signals = list(dict.fromkeys(s for gates in groups.values() for s in gates))
+    width = 0.8 / max(1, len(groups))
+    fig, ax = plt.subplots(figsize=(1.6 * len(signals) + 3, 3.4))
+    x = np.arange(len(signals))
+    for k, (name, gates) in enumerate(groups.items()):
+        per_sample = {s: _numpy(g).reshape(-1, _numpy(g).shape[-1]).mean(1) for s, g in gates.items()}
+        means = [per_sample[s].mean() if s in per_sample else np.nan for s in signals]
+        stds = [per_sample[s].std() if s in per_sample else 0.0 for s in signals]
+        ax.bar(x + (k - (len(groups) - 1) / 2) * width, means, width, yerr=stds, label=name, color=f"C{k}",
+               capsize=2)
+    ax.axhline(0.5, color="black", lw=0.8, ls=":")
+    ax.set(xticks=x, ylim=(0, 1), ylabel="mean z (0 = language, 1 = action)", title=title)
+    ax.set_xticklabels(signals)
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.0, 1.0))
+    fig.tight_layout()
+    return fig
+
+
+def word_confusion(pred, data: PGAEDataset, slot: str = "action") -> pd.DataFrame:
+    """Counts of expected (rows) against generated (columns) word at one position of a description.
+
+    ``pred`` is a :class:`pgae_lite.evaluate.Predictions` of a signal that outputs a
+    description (``describe``, ``repeat language``) on ``data`` (same order); ``slot``
+    is ``"action"``, ``"colour"`` or ``"speed"``. Words are counted as their canonical
+    form (``move-up`` counts as ``push``). A generated text with too few words or a
+    word that cannot stand at that position counts as ``"other"``.
+    """
+    from .language import SLOTS
+
+    k = SLOT_NAMES.index(slot)
+    words = list(SLOTS[k])
+    expected = [CANONICAL[VOCABULARY[int(d[0, k])]] for d in data.descriptions]
+    generated = []
+    for text in pred.text:
+        parts = text.split()
+        word = CANONICAL.get(parts[k]) if len(parts) > k else None
+        generated.append(word if word in words else "other")
+    table = pd.crosstab(pd.Categorical(expected, categories=words),
+                        pd.Categorical(generated, categories=[*words, "other"]), dropna=False)
+    table.index.name, table.columns.name = "expected", "generated"
+    return table
+
+
+def plot_word_confusion(preds: Mapping[str, object], data: PGAEDataset,
+                        slots: Sequence[str] = SLOT_NAMES, title: str = "") -> Figure:
+    """Confusion tables of :func:`word_confusion` as annotated heat maps: a row per entry, a column per slot.
+
+    ``preds`` maps a label (a view, a model) to its ``Predictions`` on ``data``,
+    e.g. ``{"NICO's view": self_preds["describe"], "opposite view": opp_preds["describe"]}``.
+    Each row of a table is normalised to the fraction of its samples; the counts are written in the cells.
+    """
+    fig, axes = plt.subplots(len(preds), len(slots), squeeze=False,
+                             figsize=(3.4 * len(slots) + 1, 2.9 * len(preds)),
+                             gridspec_kw={"width_ratios": [3 + (s == "colour") * 3 for s in slots]})
+    for r, (label, pred) in enumerate(preds.items()):
+        for c, slot in enumerate(slots):
+            table = word_confusion(pred, data, slot)
+            counts = table.to_numpy()
+            share = counts / np.maximum(counts.sum(1, keepdims=True), 1)
+            ax = axes[r, c]
+            ax.imshow(share, cmap="Blues", vmin=0, vmax=1, aspect="auto")
+            for (i, j), n in np.ndenumerate(counts):
+                if n:
+                    ax.text(j, i, str(n), ha="center", va="center", fontsize=8,
+                            color="white" if share[i, j] > 0.6 else "black")
+            ax.set_xticks(range(counts.shape[1]), table.columns, rotation=45, ha="right", fontsize=8)
+            ax.set_yticks(range(counts.shape[0]), table.index, fontsize=8)
+            ax.set_title(f"{label}: {slot}" if label else slot, fontsize=9)
+            if c == 0:
+                ax.set_ylabel("expected")
+            if r == len(preds) - 1:
+                ax.set_xlabel("generated")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def plot_similarity(similarity: np.ndarray | torch.Tensor, labels: Sequence[str], title: str = "",
+                    groups: Sequence[int] = ()) -> Figure:
+    """A square similarity matrix (e.g. cosine similarities of word vectors) as an annotated heat map.
+
+    ``labels`` name the rows and columns; ``groups`` are the indices at which a new
+    group starts (e.g. ``[6, 18]`` between the action, colour and speed words), drawn as lines.
+    """
+    similarity = _numpy(similarity)
+    n = len(labels)
+    fig, ax = plt.subplots(figsize=(0.36 * n + 2.5, 0.36 * n + 1.2))
+    im = ax.imshow(similarity, cmap="viridis", vmin=min(0.0, float(similarity.min())), vmax=1)
+    for (i, j), s in np.ndenumerate(similarity):
+        ax.text(j, i, f"{s:.1f}".lstrip("0").replace("-0", "-"), ha="center", va="center", fontsize=6,
+                color="black" if s > 0.6 else "white")
+    for g in groups:
+        ax.axhline(g - 0.5, color="white", lw=1.5)
+        ax.axvline(g - 0.5, color="white", lw=1.5)
+    ax.set_xticks(range(n), labels, rotation=90, fontsize=8)
+    ax.set_yticks(range(n), labels, fontsize=8)
+    ax.set_title(title)
+    fig.colorbar(im, ax=ax, fraction=0.04, pad=0.02, label="cosine similarity")
+    fig.tight_layout()
+    return fig
+
+
+def plot_point_map(xy: np.ndarray | torch.Tensor, labellings: Mapping[str, Sequence[str]],
+                   colours: Mapping[str, str] | None = None, title: str = "",
+                   axis_labels: tuple[str, str] = ("PC 1", "PC 2")) -> Figure:
+    """The same 2-D points several times, coloured by one labelling per panel.
+
+    ``xy`` (N, 2), e.g. the first two principal components of sentence vectors;
+    ``labellings`` maps a panel title to a label per point, e.g.
+    ``{"action": [...], "colour": [...], "speed": [...]}``. A label found in
+    ``colours`` (default :data:`WORD_COLOURS`) gets that colour, others the default cycle.
+    """
+    xy = _numpy(xy)
+    colours = WORD_COLOURS if colours is None else colours
+    fig, axes = plt.subplots(1, len(labellings), figsize=(4.2 * len(labellings), 3.8), squeeze=False,
+                             sharex=True, sharey=True)
+    for ax, (name, labels) in zip(axes[0], labellings.items()):
+        labels = np.asarray(labels)
+        for k, value in enumerate(dict.fromkeys(labels.tolist())):
+            on = labels == value
+            ax.scatter(*xy[on].T, s=12, alpha=0.75, color=colours.get(value, f"C{k}"), label=value)
+        ax.set(title=f"coloured by {name}", xlabel=axis_labels[0])
+        ax.legend(fontsize=7, markerscale=1.5, loc="best")
+    axes[0, 0].set_ylabel(axis_labels[1])
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+__all__ += ["WORD_COLOURS", "plot_histories", "plot_mean_gates", "word_confusion", "plot_word_confusion",
+            "plot_similarity", "plot_point_map"]
