@@ -2,18 +2,27 @@
 
 Modules, in the order the book introduces them:
 
-- ``language``  vocabulary, synonyms, signals, parsing and errors
-- ``data``      the dataset type, the 144 patterns and the split, the authors' data loader
-- ``toydata``   a small synthetic dataset with the paper's structure (tests, quick demos)
-- ``layers``    peephole LSTM, fused LSTM, Gated Multimodal Unit
-- ``pgae``      encoders, decoders and the PGAE model
-- ``signals``   the five signals: encoder inputs and decoder targets per batch
-- ``config``    training recipes and the profiles smoke / book / paper
-- ``train``     loss, training loop, checkpoints
-- ``evaluate``  Table 1: description accuracy and joint nRMSE
-- ``viz``       plots for the chapters
+- ``sim``         the pybullet world: robot, scene, actions, recording (chapter 01)
+- ``simdata``     the 864 simulated episodes: generation, cache, split (chapter 02)
+- ``cae``         the channel-separated convolutional autoencoder (chapter 03)
+- ``pipeline``    simulator -> CAE -> features -> trained models, each step cached
+- ``language``    vocabulary, synonyms, signals, parsing and errors (chapter 04)
+- ``data``        the dataset type, the 144 patterns and the split, the authors' data loader
+- ``toydata``     a small synthetic dataset with the paper's structure (tests, quick demos)
+- ``layers``      peephole LSTM, fused LSTM, Gated Multimodal Unit
+- ``pgae``        encoders, decoders and the PGAE model
+- ``signals``     the five signals: encoder inputs and decoder targets per batch
+- ``config``      training recipes and the profiles smoke / book / paper
+- ``train``       loss, training loop, checkpoints
+- ``evaluate``    Table 1: description accuracy and joint nRMSE
+- ``pretrained``  PGAE-BERT's frozen transformer language encoder (chapter 05)
+- ``reproduce``   every row of Table 1 (PGAE, PGAE-BERT, PGAE-self, PGAE-opposite) over seeds
+- ``closedloop``  the model drives the simulated robot; free-form instructions (chapter 07)
+- ``paraphrases`` held-out free-form paraphrases of the test instructions
+- ``playground``  one signal on one episode, and its ipywidgets front end (chapter 08)
+- ``viz``         plots and animations for the chapters
 
-Command line: ``python -m pgae_lite reproduce --original-data PATH``.
+Command line: ``python -m pgae_lite --help`` (simulate, reproduce).
 """
 
 __version__ = "0.1.0"
