@@ -15,6 +15,8 @@ import os
 from dataclasses import asdict, dataclass, field, replace
 
 from .pgae import ModelConfig
+from .language import SIGNALS
+from .signals import SIGNAL_PROBS
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 
@@ -32,6 +34,9 @@ class TrainConfig:
     clip: float | None = 1.0            # gradient-norm clipping (paper: none)
     # Deviation from paper: a signal per sample (authors: one per batch).
     signals_per_sample: bool = True
+    # How often each signal is drawn, in the order of language.SIGNALS (describe, execute,
+    # repeat action, repeat both, repeat language); authors: 3/9, 3/9, 1/9, 1/9, 1/9.
+    signal_probs: tuple[float, ...] = SIGNAL_PROBS
     # Deviation from paper: the language decoder is teacher-forced in training
     # (authors: it feeds back its own softmax, in training and at test time).
     teacher_language: bool = True
@@ -45,6 +50,13 @@ class TrainConfig:
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
+
+    def __post_init__(self):
+        probs = tuple(float(q) for q in self.signal_probs)
+        if len(probs) != len(SIGNALS) or min(probs) < 0 or abs(sum(probs) - 1) > 1e-6:
+            raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "
+                             f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
+        self.signal_probs = probs
 
 
 @dataclass

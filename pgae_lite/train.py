@@ -135,7 +135,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
                 g["lr"] = cfg.lr * lr_factor(step, total, cfg.warmup, cfg.schedule)
             index = order[b * cfg.batch_size:(b + 1) * cfg.batch_size]
             size = len(index)
-            signal = sample_signals(size, gen, cfg.signals_per_sample)
+            signal = sample_signals(size, gen, cfg.signals_per_sample, cfg.signal_probs)
             alternative = torch.randint(8, (size,), generator=gen)
             opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
             opposite &= signal != EXECUTE  # execute shows no action to the encoder

@@ -223,3 +223,18 @@ def test_lr_factor_warmup_then_cosine():
     assert [lr_factor(s, total, warmup, "constant") for s in (0, 99, 100, 999)] == \
         pytest.approx([0.01, 1.0, 1.0, 1.0])
     assert lr_factor(0, total, 0.0, "cosine") == 1.0                 # no warm-up
+
+
+def test_signal_probs_choose_the_signals_drawn(toy_short):
+    """signal_probs=0 for a signal: it is never drawn (the gate log names only drawn signals)."""
+    no_both = (0.375, 0.375, 0.125, 0.0, 0.125)
+    run = train(toy_short, tiny_profile(epochs=3, signal_probs=no_both), progress=False)
+    drawn = set().union(*(r["gate"] for r in run.history))
+    assert "repeat both" not in drawn and {"describe", "execute"} <= drawn
+    assert run.profile.train.signal_probs == no_both
+
+
+@pytest.mark.parametrize("probs", [(0.5, 0.5), (0.5, 0.5, 0.5, 0.0, 0.0), (1.2, -0.2, 0.0, 0.0, 0.0)])
+def test_bad_signal_probs_say_what_is_allowed(probs):
+    with pytest.raises(ValueError, match="5 non-negative numbers summing to 1.*describe, execute"):
+        get_profile("smoke", signal_probs=probs)
