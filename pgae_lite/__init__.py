@@ -20,6 +20,7 @@ Modules, in the order the book introduces them:
 - ``closedloop``  the model drives the simulated robot; free-form instructions (chapter 07)
 - ``paraphrases`` held-out free-form paraphrases of the test instructions
 - ``playground``  one signal on one episode, and its ipywidgets front end (chapter 08)
+- ``exercises``   check functions: a student's code against the package's, and what is wrong
 - ``viz``         plots and animations for the chapters
 
 Command line: ``python -m pgae_lite --help`` (simulate, reproduce).
