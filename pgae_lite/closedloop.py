@@ -3,7 +3,7 @@
 Paper, Sec. 3 (Action Autoencoder) and Sec. 4 (the "execute" task). In the
 paper's execute the action decoder reads, at every step, the visual features of
 the *recorded* execution (authors' code), so it never sees what its own joints
-do: it is open-loop. Here the model's own motion makes the images it reads:
+do: it is open-loop. Here the model's own motion makes the images it reads::
 
     frame_0 = NICO at its start pose                      (as every recording starts)
     h       = encode(signal execute + description, [v_0; j_0])

@@ -1,13 +1,13 @@
 """Reproducing Table 1: train the rows' models, evaluate them, print them beside the paper's.
 
-Paper, Sec. 4 and Table 1. Four rows come from three trainings:
+Paper, Sec. 4 and Table 1. Four rows come from three trainings::
 
-| row           | training                                   | evaluated on                  |
-|---------------|--------------------------------------------|-------------------------------|
-| PGAE          | LSTM language encoder, NICO's view only     | NICO's own actions            |
-| PGAE-BERT     | frozen pretrained language encoder          | NICO's own actions            |
-| PGAE-self     | NICO's or the opposite agent's view, 50/50  | NICO's own actions            |
-| PGAE-opposite | the same model as PGAE-self                 | the opposite agent's actions  |
+    | row           | training                                   | evaluated on                  |
+    |---------------|--------------------------------------------|-------------------------------|
+    | PGAE          | LSTM language encoder, NICO's view only     | NICO's own actions            |
+    | PGAE-BERT     | frozen pretrained language encoder          | NICO's own actions            |
+    | PGAE-self     | NICO's or the opposite agent's view, 50/50  | NICO's own actions            |
+    | PGAE-opposite | the same model as PGAE-self                 | the opposite agent's actions  |
 
 ``execute`` and ``repeat language`` show no action to the encoder beyond the
 first step, so PGAE-opposite shares those two cells with PGAE-self (as in the
@@ -47,6 +47,7 @@ class Training:
     train: dict = field(default_factory=dict)
 
 
+#: training name -> what it changes in the profile (model and training options)
 TRAININGS: dict[str, Training] = {
     "PGAE": Training(),
     "PGAE-BERT": Training(model={"language_encoder": "pretrained"}),

@@ -1,15 +1,15 @@
 """The five signals: what each task feeds the encoders and expects from the decoders.
 
 Paper, Sec. 3 ("Signals") and Table 1's tasks. One model does every task; the
-signal word prepended to the language input picks it:
+signal word prepended to the language input picks it::
 
-| signal          | language in          | action in     | language target | action target       |
-|-----------------|----------------------|---------------|-----------------|---------------------|
-| describe        | signal + <EOS>       | whole         | description     | final joints, held  |
-| execute         | signal + description | first step    | <EOS>           | whole joint sequence|
-| repeat action   | signal + <EOS>       | whole         | <EOS>           | whole joint sequence|
-| repeat both     | signal + description | whole         | description     | whole joint sequence|
-| repeat language | signal + description | first step    | description     | first joints, held  |
+    | signal          | language in          | action in     | language target | action target       |
+    |-----------------|----------------------|---------------|-----------------|---------------------|
+    | describe        | signal + <EOS>       | whole         | description     | final joints, held  |
+    | execute         | signal + description | first step    | <EOS>           | whole joint sequence|
+    | repeat action   | signal + <EOS>       | whole         | <EOS>           | whole joint sequence|
+    | repeat both     | signal + description | whole         | description     | whole joint sequence|
+    | repeat language | signal + description | first step    | description     | first joints, held  |
 
 :func:`make_batch` builds all of it for a batch in which every sample may
 carry its own signal, description alternative and view.

@@ -19,7 +19,7 @@ missing. A file whose digest does not match the manifest (or, if it is not in
 the manifest yet, whose contents fail their own check) is reported and
 recorded again, never used.
 
-:func:`simulated_dataset` turns the episodes into the same
+:func:`~pgae_lite.pipeline.simulated_dataset` turns the episodes into the same
 :class:`~pgae_lite.data.PGAEDataset` as the authors' loader produces, with
 visual features from a trained channel-separated CAE (also cached).
 """
@@ -294,7 +294,7 @@ def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ..
 
 def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray],
                progress: bool = True) -> PGAEDataset:
-    """The episodes as a :class:`PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
+    """The episodes as a :class:`~pgae_lite.data.PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
     episodes = tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
                     unit="ep", disable=not progress)
     return from_recordings(((Pattern.from_number(ep.pattern), f"sim/{episode_name(ep.pattern, ep.variation)}",

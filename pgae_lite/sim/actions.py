@@ -17,7 +17,7 @@ itself) or slides (sideways) one of the two cubes, slowly (100 steps) or fast
    waypoints the hand follows a minimum-jerk profile,
    s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, which starts and stops smoothly.
 3. Joint angles by position-only IK along the path
-   (:meth:`Robot.inverse_kinematics`), each solve seeded with the previous one.
+   (:meth:`~pgae_lite.sim.robot.Robot.inverse_kinematics`), each solve seeded with the previous one.
 
 The simulator then drives the joints with position control and contact
 physics moves the cube; :func:`check_action` says whether it moved the way

@@ -20,7 +20,7 @@ Seeds: the episode (pattern, variation, base_seed) tries seeds
 ``episode_seed(pattern, variation, base_seed, attempt)`` for attempt = 0, 1, ...
 (plain integers, no ``hash()``); the cube positions depend on (pattern,
 variation, base_seed) only, the trajectory's offsets also on the attempt. An
-attempt is kept when both agents' actions pass :func:`check_action`; after
+attempt is kept when both agents' actions pass :func:`~pgae_lite.sim.actions.check_action`; after
 ``max_attempts`` failures :func:`record_episode` raises. The world is rebuilt
 for every execution (``resetSimulation``), so the same arguments give
 bit-identical joints and images.

@@ -99,7 +99,7 @@ class Scene:
     other agent sits still at its start pose and is drawn into the backdrop.
     ``opposite_agent=False`` leaves the second robot out.
     Attributes: ``client`` (a ``BulletClient``), ``nico`` and ``opposite``
-    (:class:`Robot`, the latter ``None`` when absent), ``cubes`` (body ids,
+    (:class:`~pgae_lite.sim.robot.Robot`, the latter ``None`` when absent), ``cubes`` (body ids,
     left then right), ``table``, ``actor``.
     """
 
