@@ -1,11 +1,14 @@
 """Training throughput of PGAE on the authors' data: samples per second and seconds per epoch.
 
     python benchmarks/throughput.py [--data PATH] [--batches 6 64] [--cells lstm peephole]
+                                    [--feedback teacher own start]
 
 For each cell and batch size it times full training steps (signals drawn per
-sample, forward, loss, backward, Adam), with the action decoder teacher-forced
-on joints and free-running (its own predictions), and extrapolates to one
-epoch of the 648 training samples. Run it on an otherwise idle machine.
+sample, forward, loss, backward, Adam) for each way the action decoder reads
+joints: ``teacher`` (the recorded ones), ``own`` (its own predictions, the
+paper's) and ``start`` (the start joints at every step, joint_feedback="start"),
+and extrapolates to one epoch of the 648 training samples. Run it on an
+otherwise idle machine.
 """
 import argparse
 import json
@@ -23,8 +26,12 @@ ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDe
 ap.add_argument("--data", default="../shared/pgae-original-data")
 ap.add_argument("--batches", type=int, nargs="+", default=[6, 64])
 ap.add_argument("--cells", nargs="+", default=["lstm", "peephole"])
+ap.add_argument("--feedback", nargs="+", default=["teacher", "own", "start"], choices=["teacher", "own", "start"])
+ap.add_argument("--threads", type=int, default=None, help="torch threads (default: torch's choice)")
 ap.add_argument("--seconds", type=float, default=10.0, help="time budget per measurement")
 args = ap.parse_args()
+if args.threads:
+    torch.set_num_threads(args.threads)
 
 data = load_original(args.data).split("train")
 tensors = Normaliser.fit(data).tensors(data)
@@ -32,9 +39,10 @@ weights = word_weights()
 rows = []
 for cell in args.cells:
     for bs in args.batches:
-        for teacher in (True, False):
+        for feedback in args.feedback:
             torch.manual_seed(0)
-            model = PGAE(ModelConfig(cell=cell))
+            teacher = feedback == "teacher"
+            model = PGAE(ModelConfig(cell=cell, joint_feedback="start" if feedback == "start" else "predicted"))
             opt = torch.optim.Adam(model.parameters(), 1e-3)
             gen = torch.Generator().manual_seed(0)
 
@@ -52,7 +60,7 @@ for cell in args.cells:
                 step()
                 n += 1
             dt = (time.perf_counter() - t0) / n
-            row = {"cell": cell, "batch": bs, "joints": "teacher" if teacher else "own",
+            row = {"cell": cell, "batch": bs, "joints": feedback,
                    "samples_per_s": round(bs / dt, 1), "s_per_epoch": round(dt * len(data) / bs, 2)}
             rows.append(row)
             print(json.dumps(row), flush=True)

@@ -25,7 +25,7 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 class TrainConfig:
     """How PGAE is trained. Defaults are the ``book`` recipe."""
 
-    epochs: int = 400
+    epochs: int = 800
     batch_size: int = 64
     # Deviation from paper: Adam 2e-3 with warm-up and cosine decay (paper: 1e-5, constant).
     lr: float = 2e-3
@@ -42,6 +42,8 @@ class TrainConfig:
     teacher_language: bool = True
     # Deviation from paper: the action decoder gets the recorded joints for this
     # fraction of training, then its own predictions (authors: 0, always its own).
+    # Only with ModelConfig(joint_feedback="predicted"); the book's decoder reads
+    # the start joints (joint_feedback="start") and needs no teacher forcing.
     teacher_joints_until: float = 0.75
     joint_noise: float = 0.0            # std of noise on the recorded joints read under teacher forcing
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
@@ -71,10 +73,14 @@ class Profile:
         return {"name": self.name, "model": asdict(self.model), "train": asdict(self.train)}
 
 
+# Deviation from paper (book and smoke): the action decoder reads the start joints at every
+# step instead of its own previous prediction (ModelConfig.joint_feedback, see pgae.ActionDecoder).
+BOOK_MODEL = ModelConfig(joint_feedback="start")
+
 PROFILES: dict[str, Profile] = {
-    "smoke": Profile("smoke", ModelConfig(units=32), TrainConfig(
+    "smoke": Profile("smoke", replace(BOOK_MODEL, units=32), TrainConfig(
         epochs=3, batch_size=32, lr=3e-3, max_train_samples=96, checkpoint_every=1)),
-    "book": Profile("book"),
+    "book": Profile("book", BOOK_MODEL),
     "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
         epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
         signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0,

@@ -184,17 +184,19 @@ class ActionDecoder(nn.Module):
         decoder then stops computing a sample after its last step (outputs 0 there).
         """
         state = self.begin(h)
-        if self.feedback == "start":
-            # Deviation from paper: the decoder reads the start joints at every step instead of
-            # its own predictions, so its small errors cannot feed back and grow, and training
-            # and test run the same single fused pass (no teacher forcing needed).
-            prev = start[:, None].expand(-1, vision.shape[1], -1)            # (B, S, 5)
-            y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
-            return torch.tanh(self.out(y))
-        if teacher_joints is not None:                          # inputs ĵ_t := recorded j_t
-            prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)   # (B, S, 5)
-            y, _ = self.rnn(torch.cat([vision, prev], 2), None, state)
-            return torch.tanh(self.out(y))
+        if self.feedback == "start" or teacher_joints is not None:
+            if self.feedback == "start":
+                # Deviation from paper: the decoder reads the start joints at every step instead of
+                # its own predictions, so its small errors cannot feed back and grow, and training
+                # and test run the same single fused pass (no teacher forcing needed).
+                prev = start[:, None].expand(-1, vision.shape[1], -1)         # (B, S, 5)
+            else:                                                             # inputs ĵ_t := recorded j_t
+                prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)  # (B, S, 5)
+            y, _ = self.rnn(torch.cat([vision, prev], 2), steps, state)      # each sample for its own steps
+            joints = torch.tanh(self.out(y))                                  # (B, S, 5)
+            if steps is not None:                                             # 0 past a sample's last step
+                joints = joints * (torch.arange(vision.shape[1], device=vision.device) < steps[:, None])[..., None]
+            return joints
         B, S, _ = vision.shape
         if steps is None:
             steps = torch.full((B,), S, device=vision.device)
