@@ -46,6 +46,10 @@ class TrainConfig:
     # the start joints (joint_feedback="start") and needs no teacher forcing.
     teacher_joints_until: float = 0.75
     joint_noise: float = 0.0            # std of noise on the recorded joints read under teacher forcing
+    # Deviation from paper: Gaussian noise of this std on the action encoder's inputs (vision and
+    # joints, in model units [-1, 1]) in training. Measured on the authors' data (seed 0, 800
+    # epochs): describe 65-87% -> 93%, repeat action nRMSE 0.61-0.72% -> 0.33%.
+    input_noise: float = 0.05
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β
@@ -83,7 +87,7 @@ PROFILES: dict[str, Profile] = {
     "book": Profile("book", BOOK_MODEL),
     "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
         epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
-        signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0,
+        signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0, input_noise=0.0,
         checkpoint_every=100)),
 }
 

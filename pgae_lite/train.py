@@ -140,6 +140,8 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
             opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
+            if cfg.input_noise:  # regularises what the action encoder reads (vision and joints, model units)
+                batch.action_input = batch.action_input + cfg.input_noise * torch.randn_like(batch.action_input)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
                         feedback="greedy" if cfg.teacher_language else "soft", joint_noise=cfg.joint_noise)
             loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)

@@ -238,3 +238,13 @@ def test_signal_probs_choose_the_signals_drawn(toy_short):
 def test_bad_signal_probs_say_what_is_allowed(probs):
     with pytest.raises(ValueError, match="5 non-negative numbers summing to 1.*describe, execute"):
         get_profile("smoke", signal_probs=probs)
+
+
+def test_input_noise_changes_training_and_stays_deterministic(toy_short):
+    """Noise on the action encoder's inputs: another run than without, the same run twice."""
+    clean = train(toy_short, tiny_profile(epochs=2, input_noise=0.0), progress=False, device="cpu")
+    noisy = [train(toy_short, tiny_profile(epochs=2, input_noise=0.05), progress=False, device="cpu")
+             for _ in range(2)]
+    assert noisy[0].history == noisy[1].history
+    assert noisy[0].history != clean.history
+    assert get_profile("paper").train.input_noise == 0.0    # the paper's recipe has none
