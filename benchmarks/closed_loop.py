@@ -15,11 +15,8 @@ takes N episodes evenly spread over the 216 of the test split. Run it with
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import time
-from pathlib import Path
 
 import torch
 
@@ -27,6 +24,8 @@ from pgae_lite.closedloop import compare, success_summary
 from pgae_lite.pipeline import simulated_dataset, trained_cae
 from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import load_model
+
+from _report import write_report   # benchmarks/_report.py (the script's folder is on sys.path)
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("checkpoint", help="a PGAE checkpoint trained on the profile's simulated data")
@@ -55,14 +54,6 @@ if len(failed):
     print(f"\nclosed-loop failures: {len(failed)} (the first 10; all of them in the JSON)")
     print(failed[["id", "description", "open_passed", "closed_nrmse", "closed_reason"]].head(10).to_string(index=False))
 
-out = Path(args.out)
-out.parent.mkdir(parents=True, exist_ok=True)
-out.write_text(json.dumps({
-    "checkpoint": args.checkpoint, "profile": args.profile, "limit": args.limit,
-    "tracking": not args.no_tracking, "model": ckpt["profile"]["model"],
-    "seconds": seconds, "seconds_per_episode": seconds / len(table),
-    "threads": torch.get_num_threads(), "machine": platform.processor() or platform.machine(),
-    "load_average": os.getloadavg()[0],
-    "summary": summary.reset_index().to_dict(orient="records"),
-    "episodes": table.to_dict(orient="records")}, indent=1))
-print(f"\nwritten to {out}")
+write_report(args.out, table, summary, seconds,
+             checkpoint=args.checkpoint, profile=args.profile, limit=args.limit,
+             tracking=not args.no_tracking, model=ckpt["profile"]["model"])

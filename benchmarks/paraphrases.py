@@ -23,11 +23,8 @@ Run it with ``OMP_NUM_THREADS=1``: the models are small, a second thread does no
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import time
-from pathlib import Path
 
 import torch
 
@@ -36,6 +33,8 @@ from pgae_lite.language import LanguageError
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import load_model
+
+from _report import write_report   # benchmarks/_report.py (the script's folder is on sys.path)
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("checkpoint", nargs="?", help="a PGAE-BERT checkpoint (default: the profile's cached model)")
@@ -73,14 +72,6 @@ if len(failed):
     print(f"\n{loop}-loop failures: {len(failed)} (the first 10; all of them in the JSON)")
     print(failed[["id", "meaning", "description", f"{loop}_reason"]].head(10).to_string(index=False))
 
-out = Path(args.out)
-out.parent.mkdir(parents=True, exist_ok=True)
-out.write_text(json.dumps({
-    "checkpoint": args.checkpoint or f"trained_pgae('PGAE-BERT', {args.profile!r}, seed={args.seed})",
-    "profile": args.profile, "limit": args.limit, "closed": not args.open_only, "model": model_config,
-    "seconds": seconds, "seconds_per_episode": seconds / len(table),
-    "threads": torch.get_num_threads(), "machine": platform.processor() or platform.machine(),
-    "load_average": os.getloadavg()[0],
-    "summary": summary.reset_index().to_dict(orient="records"),
-    "episodes": table.to_dict(orient="records")}, indent=1))
-print(f"\nwritten to {out}")
+write_report(args.out, table, summary, seconds,
+             checkpoint=args.checkpoint or f"trained_pgae('PGAE-BERT', {args.profile!r}, seed={args.seed})",
+             profile=args.profile, limit=args.limit, closed=not args.open_only, model=model_config)
