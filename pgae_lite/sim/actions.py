@@ -66,8 +66,8 @@ class Variation:
     phases: tuple[float, ...] = PHASES
 
 
-def sample_variation(rng: np.random.Generator, distance: tuple[float, float] = (0.08, 0.10),
-                     lateral: float = 0.006, height: float = 0.004, timing: float = 0.15) -> Variation:
+def sample_variation(rng: np.random.Generator, distance: tuple[float, float] = (0.085, 0.095),
+                     lateral: float = 0.006, height: float = 0.004, timing: float = 0.05) -> Variation:
     """Draw the small random differences between recordings of one pattern.
 
     ``distance`` is a (low, high) range in metres; ``lateral`` and ``height``
