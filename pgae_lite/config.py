@@ -50,6 +50,7 @@ class TrainConfig:
     # joints, in model units [-1, 1]) in training. Measured on the authors' data (seed 0, 800
     # epochs): describe 65-87% -> 93%, repeat action nRMSE 0.61-0.72% -> 0.33%.
     input_noise: float = 0.05
+    joint_input_noise: float | None = None   # std on the joints part only; None: input_noise
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β

@@ -22,7 +22,7 @@ from torch import nn
 from tqdm.auto import tqdm
 
 from .config import Profile, get_profile
-from .data import Normaliser, PGAEDataset
+from .data import JOINT_DIM, Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .pgae import PGAE, ModelConfig
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
@@ -75,6 +75,17 @@ class Trained:
     history: list[dict]
     profile: Profile
     seconds: float
+
+
+def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | None = None) -> torch.Tensor:
+    """``action_input`` (B, T, 30 + 5) plus Gaussian noise: ``std`` on the visual features, ``joint_std``
+    on the joints (``None``: ``std`` on both)."""
+    noise = torch.randn_like(action_input)
+    if joint_std is None:
+        return action_input + std * noise
+    scale = torch.full((action_input.shape[-1],), std, device=action_input.device)
+    scale[-JOINT_DIM:] = joint_std                                        # the last 5 channels are joints
+    return action_input + scale * noise
 
 
 def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
@@ -141,7 +152,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
             if cfg.input_noise:  # regularises what the action encoder reads (vision and joints, model units)
-                batch.action_input = batch.action_input + cfg.input_noise * torch.randn_like(batch.action_input)
+                batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
                         feedback="greedy" if cfg.teacher_language else "soft", joint_noise=cfg.joint_noise)
             loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)

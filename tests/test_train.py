@@ -248,3 +248,16 @@ def test_input_noise_changes_training_and_stays_deterministic(toy_short):
     assert noisy[0].history == noisy[1].history
     assert noisy[0].history != clean.history
     assert get_profile("paper").train.input_noise == 0.0    # the paper's recipe has none
+
+
+def test_add_input_noise_separates_vision_and_joints():
+    from pgae_lite.train import add_input_noise
+    x = torch.zeros(4, 100, 35)
+    torch.manual_seed(0)
+    both = add_input_noise(x, 0.05)
+    assert 0.045 < both[..., :30].std() < 0.055 and 0.045 < both[..., 30:].std() < 0.055
+    vision_only = add_input_noise(x, 0.05, joint_std=0.0)
+    assert vision_only[..., 30:].abs().max() == 0            # the joints stay exact
+    assert 0.045 < vision_only[..., :30].std() < 0.055
+    torch.manual_seed(0)
+    assert torch.equal(add_input_noise(x, 0.05, joint_std=None), both)   # None: the same std on both
