@@ -61,7 +61,8 @@ def test_pgae_bert_executes_a_paraphrase_in_every_test_episode(smoke):
     both = execute_paraphrases(bert.model, cae, bert.normaliser, data, limit=2, config=SMOKE, progress=False)
     assert len(both) == 2 and both["closed_passed"].dtype == bool and np.isfinite(both["closed_nrmse"]).all()
     same = table.set_index("id").loc[both["id"]]
-    assert np.array_equal(same["open_nrmse"].to_numpy(), both["open_nrmse"].to_numpy())
+    # (close, not bit-equal: a batch of 2 sums in another order than a batch of all 36)
+    assert np.allclose(same["open_nrmse"].to_numpy(), both["open_nrmse"].to_numpy(), rtol=1e-5, atol=0)
     assert np.array_equal(same["open_passed"].to_numpy(), both["open_passed"].to_numpy())
     first = both.iloc[0]
     run = closed_loop(bert.model, cae, bert.normaliser, int(first.pattern), int(first.variation), config=SMOKE,
