@@ -62,8 +62,9 @@ for row in rows:
                      "std": statistics.stdev([c[s][k] for c in per_seed]) if len(per_seed) > 1 else 0.0}
                  for k in ("accuracy", "nrmse")} for s in TEST_SIGNALS}
     paper = PAPER_TABLE[row]
-    verdict = {s: {"accuracy": stats[s]["accuracy"]["median"] >= paper[s][0],
-                   "nrmse": stats[s]["nrmse"]["median"] <= paper[s][1]} for s in TEST_SIGNALS}
+    # The paper prints two decimals: 80.56 stands for 174/216 = 80.5556, so compare within half a unit.
+    verdict = {s: {"accuracy": stats[s]["accuracy"]["median"] >= paper[s][0] - 0.005,
+                   "nrmse": stats[s]["nrmse"]["median"] <= paper[s][1] + 0.005} for s in TEST_SIGNALS}
     summary[row] = {"seeds": dict(zip(map(str, args.seeds), per_seed)), "train_seconds": seconds,
                     "stats": stats, "paper": paper, "verdict": verdict}
     lines += [f"== {row} ({source} data, {args.profile})", head]

@@ -44,7 +44,7 @@ from .sim.record import Episode, SimConfig, record_episode
 
 CACHE_ENV = "PGAE_LITE_CACHE"
 #: Bump when the simulator changes what it records: old caches are then not reused.
-GENERATOR_VERSION = 2
+GENERATOR_VERSION = 4
 IMAGE_SHAPE = (120, 160, 3)
 MIN_JOBS_PER_WORKER = 24      # below this many episodes per process, one process is faster
 

@@ -9,11 +9,15 @@ itself) or slides (sideways) one of the two cubes, slowly (100 steps) or fast
    FROM THE OTHER CUBE (the left cube to the left, the right cube to the
    right), so the two cubes never collide. Seen from above, a slide therefore
    moves a cube the same way whichever agent does it.
-2. A hand path through six waypoints: the start pose's hand position, a
+2. A hand path through eight waypoints: the start pose's hand position, a
    point above the contact point, the contact point (beside the cube, on the
    side opposite to the direction), the end point (the cube has moved about
-   ``distance``), the end point lifted, and a point part of the way back to
-   the start (so the hand does not hide the cube in the last frame). Between
+   ``distance``), the end point lifted, a point part of the way back, still
+   rising (clearing the cubes), and the start position again, where the
+   hand rests for the last few steps. Ending at rest at the start keeps the
+   hand off the cubes in the last frames, so the camera sees both colours
+   when the action is over (a hand left above a cube hides it from NICO's
+   eye and makes "which colour was that?" hard to learn). Between
    waypoints the hand follows a minimum-jerk profile,
    s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5, which starts and stops smoothly.
 3. Joint angles by position-only IK along the path
@@ -42,10 +46,12 @@ APPROACH_GAP = {"push": 0.02, "pull": 0.02, "slide": 0.012}   # free space befor
 CONTACT_HEIGHT = 0.018       # fingertip height while pushing (m above the table; cube top at 0.05)
 APPROACH_HEIGHT = 0.09       # fingertip height above the contact point, before descending (m)
 LIFT = 0.06                  # how far the hand rises after the push (m), clearing the cube tops
-RETREAT = 0.4                # then it moves this share of the way back towards the start (xy)
+RETREAT = 0.4                # then it moves this share of the way back towards the start (xy), rising,
+                             # and from there back to the start
 ARC = 0.04                   # the reach to the cube bulges up by this much (m), clearing the other cube
-#: Share of the steps spent on each segment: reach above, descend, move the cube, lift, return.
-PHASES = (0.28, 0.14, 0.33, 0.10, 0.15)
+#: Share of the steps spent on each segment: reach above, descend, move the cube, lift, back over
+#: the cubes, home, rest there.
+PHASES = (0.27, 0.13, 0.32, 0.05, 0.06, 0.11, 0.06)
 
 # Check thresholds (defaults of SimConfig): the cube must move at least MIN_MOVE along
 # the direction, sideways at most MAX_OFF_AXIS_RATIO of that, and the other cube less
@@ -67,7 +73,7 @@ class Variation:
 
 
 def sample_variation(rng: np.random.Generator, distance: tuple[float, float] = (0.085, 0.095),
-                     lateral: float = 0.006, height: float = 0.004, timing: float = 0.05) -> Variation:
+                     lateral: float = 0.006, height: float = 0.004, timing: float = 0.02) -> Variation:
     """Draw the small random differences between recordings of one pattern.
 
     ``distance`` is a (low, high) range in metres; ``lateral`` and ``height``
@@ -106,7 +112,10 @@ def min_jerk(tau: np.ndarray) -> np.ndarray:
 
 def hand_waypoints(action: str, cube: np.ndarray, other: np.ndarray, home: np.ndarray,
                    variation: Variation = Variation()) -> np.ndarray:
-    """The six hand waypoints (6, 3) in the agent's frame, for cube centres ``cube``, ``other`` (3,)."""
+    """The eight hand waypoints (8, 3) in the agent's frame, for cube centres ``cube``, ``other`` (3,).
+
+    The last two are both the start position: the last segment is a rest.
+    """
     d = direction(action, cube[:2], other[:2])
     across = np.array([-d[1], d[0]])                            # d turned by 90 degrees
     offset = CONTACT_OFFSET[action]
@@ -120,6 +129,8 @@ def hand_waypoints(action: str, cube: np.ndarray, other: np.ndarray, home: np.nd
         [*end_xy, z],                                           # the cube has moved
         [*end_xy, z + LIFT],                                    # lifted off the cube
         [*(end_xy + RETREAT * (home[:2] - end_xy)), z + LIFT + 0.02],   # on the way back, still rising
+        home,                                                   # back at the start: both cubes in view
+        home,                                                   # and rest there
     ])
 
 

@@ -58,12 +58,12 @@ class SimConfig:
     # (when each phase starts, how far the cube is pushed) puts a floor under any model's joint
     # error. With cube jitter +-1 cm, travel 8-10 cm and timing x[0.85, 1.15], the six recordings of
     # a pattern spread by 0.77% nRMSE around their mean (planned joints), above the paper's 0.44%;
-    # with the values below, 0.40% (benchmarks/variation_floor.py).
+    # with the values below, 0.34% (benchmarks/variation_floor.py).
     cube_jitter: float = 0.005                # cube centres move by up to +-5 mm in x and y
     distance: tuple[float, float] = (0.085, 0.095)   # planned cube travel (m), uniform
     lateral_jitter: float = 0.006             # contact point across the direction, +- (m)
     height_jitter: float = 0.004              # contact height, +- (m)
-    timing_jitter: float = 0.05               # each phase's share of the steps, x [0.95, 1.05]
+    timing_jitter: float = 0.02               # each phase's share of the steps, x [0.98, 1.02]
     ik_every: int = 4                         # IK at every 4th step of the hand path, linear in between
     min_move: float = MIN_MOVE                # check: cube moved >= 4 cm along the direction
     max_off_axis_ratio: float = MAX_OFF_AXIS_RATIO   # ... and sideways <= 0.5 x that
