@@ -88,6 +88,13 @@ def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | N
     return action_input + scale * noise
 
 
+def hold_first_frame(dec_vision: torch.Tensor, blind: torch.Tensor) -> torch.Tensor:
+    """``dec_vision`` (B, T-1, 30) with the samples where ``blind`` (B,) is true reading their first
+    frame at every step: the decoder then has to carry the plan in its state."""
+    first = dec_vision[:, :1].expand_as(dec_vision)                        # (B, T-1, 30)
+    return torch.where(blind[:, None, None], first, dec_vision)
+
+
 def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
           device: torch.device | str | None = None, progress: bool = True,
           model: PGAE | None = None, callback=None) -> Trained:
@@ -110,7 +117,8 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
 
     torch.manual_seed(cfg.seed)
     model = (model or PGAE(profile.model)).to(device)
-    optimiser = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    optimiser = (torch.optim.AdamW(model.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+                 if cfg.weight_decay else torch.optim.Adam(model.parameters(), lr=cfg.lr))
     gen = torch.Generator().manual_seed(cfg.seed)  # signals, descriptions, views, shuffling
     n = len(train_set)
     batches = math.ceil(n / cfg.batch_size)
@@ -151,6 +159,9 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
             opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
+            if cfg.decoder_vision_dropout:
+                blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout
+                batch.dec_vision = hold_first_frame(batch.dec_vision, blind.to(device))
             if cfg.input_noise:  # regularises what the action encoder reads (vision and joints, model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,

@@ -261,3 +261,28 @@ def test_add_input_noise_separates_vision_and_joints():
     assert 0.045 < vision_only[..., :30].std() < 0.055
     torch.manual_seed(0)
     assert torch.equal(add_input_noise(x, 0.05, joint_std=None), both)   # None: the same std on both
+
+
+def test_hold_first_frame_only_for_the_blind_samples():
+    from pgae_lite.train import hold_first_frame
+    vision = torch.randn(3, 9, 30)
+    out = hold_first_frame(vision, torch.tensor([True, False, True]))
+    assert torch.equal(out[1], vision[1])                                  # not chosen: unchanged
+    for b in (0, 2):
+        assert torch.equal(out[b], vision[b, :1].expand(9, 30))            # chosen: frame 0 at every step
+
+
+def test_decoder_vision_dropout_changes_training_and_stays_deterministic(toy_short):
+    plain = train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu")
+    blind = [train(toy_short, tiny_profile(epochs=2, decoder_vision_dropout=0.5), progress=False, device="cpu")
+             for _ in range(2)]
+    assert blind[0].history == blind[1].history
+    assert blind[0].history != plain.history
+    assert get_profile("paper").train.decoder_vision_dropout == 0.0
+
+
+def test_weight_decay_uses_adamw(toy_short):
+    plain = train(toy_short, tiny_profile(epochs=2, weight_decay=0.0), progress=False, device="cpu")
+    decayed = train(toy_short, tiny_profile(epochs=2, weight_decay=0.1), progress=False, device="cpu")
+    assert decayed.history != plain.history
+    assert get_profile("paper").train.weight_decay == 0.0
