@@ -43,7 +43,8 @@ def cb(epoch, model, rec):
         return
     t = time.perf_counter() - t0
     from pgae_lite.data import Normaliser
-    res, _ = evaluate(model, ds, Normaliser.fit(ds.split("train")))
+    norm = Normaliser.fit(ds.split("train"), per_feature=prof.train.vision_scaling == "per_feature")
+    res, _ = evaluate(model, ds, norm)
     line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
             **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
             "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}

@@ -21,6 +21,9 @@ from .signals import SIGNAL_PROBS
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 
 
+VISION_SCALINGS = ("global", "per_feature")
+
+
 @dataclass
 class TrainConfig:
     """How PGAE is trained. Defaults are the ``book`` recipe."""
@@ -62,6 +65,13 @@ class TrainConfig:
     # copy it from the recorded pictures, which a robot acting on its own never has. Off in the book
     # recipe; 0.5 makes the closed loop work (chapter 07) at some cost in nRMSE (README).
     decoder_vision_dropout: float = 0.0
+    # Deviation from paper: the chance that a sample's action encoder (NICO's own view only) reads the
+    # first frame held at every step, so that it learns to take the colours from the scene before the
+    # action and the action from the joints, not from the moved cube's (unfamiliar) end position.
+    encoder_vision_dropout: float = 0.0
+    # How the visual features are scaled to [-1, 1]: "global" (the authors': one min and max over all
+    # 30 features) or "per_feature" (a min and max for each feature; see data.Normaliser).
+    vision_scaling: str = "global"
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β
     seed: int = 0
@@ -74,6 +84,8 @@ class TrainConfig:
             raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "
                              f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
         self.signal_probs = probs
+        if self.vision_scaling not in VISION_SCALINGS:
+            raise ValueError(f"unknown vision_scaling {self.vision_scaling!r}; choose one of: {', '.join(VISION_SCALINGS)}")
 
 
 @dataclass

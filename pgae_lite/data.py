@@ -110,25 +110,35 @@ class Normaliser:
 
     Deviation from paper: the authors take min/max over train and test
     together; we use the training split only, so the test set stays unseen.
+    With ``per_feature`` the visual features get a min and max per feature
+    instead (``vision`` then holds two tuples of 30).
     """
 
     joints: tuple[float, float]
-    vision: tuple[float, float]
-    vision_opposite: tuple[float, float]
+    vision: tuple
+    vision_opposite: tuple
 
     @classmethod
-    def fit(cls, data: PGAEDataset) -> "Normaliser":
+    def fit(cls, data: PGAEDataset, per_feature: bool = False) -> "Normaliser":
         """Statistics from the valid steps of ``data`` (pass the training split)."""
         m = data.mask
 
         def lo_hi(x: np.ndarray) -> tuple[float, float]:
             return float(x[m].min()), float(x[m].max())
-        return cls(lo_hi(data.joints), lo_hi(data.vision), lo_hi(data.vision_opposite))
+
+        def lo_hi_each(x: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]]:
+            return tuple(map(float, x[m].min(0))), tuple(map(float, x[m].max(0)))    # (F,), (F,)
+        scale = lo_hi_each if per_feature else lo_hi
+        return cls(lo_hi(data.joints), scale(data.vision), scale(data.vision_opposite))
+
+    @property
+    def per_feature(self) -> bool:
+        return isinstance(self.vision[0], tuple)
 
     @staticmethod
-    def _scale(x: np.ndarray, lo_hi: tuple[float, float]) -> np.ndarray:
-        lo, hi = lo_hi
-        return (2.0 * (x - lo) / (hi - lo) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
+    def _scale(x: np.ndarray, lo_hi: tuple) -> np.ndarray:
+        lo, hi = (np.asarray(v, dtype=np.float64) for v in lo_hi)          # scalars, or (F,) per feature
+        return (2.0 * (x - lo) / np.maximum(hi - lo, 1e-12) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
 
     def joints_to_model(self, x: np.ndarray) -> np.ndarray:
         """Joints in the data's own units -> the model's [-1, 1]."""
@@ -155,13 +165,17 @@ class Normaliser:
             "descriptions": torch.from_numpy(data.descriptions.astype(np.int64)).to(device),
         }
 
-    def state_dict(self) -> dict[str, list[float]]:
-        return {"joints": list(self.joints), "vision": list(self.vision),
-                "vision_opposite": list(self.vision_opposite)}
+    def state_dict(self) -> dict[str, list]:
+        def plain(v):
+            return [list(x) if isinstance(x, tuple) else x for x in v]
+        return {"joints": plain(self.joints), "vision": plain(self.vision),
+                "vision_opposite": plain(self.vision_opposite)}
 
     @classmethod
     def from_state_dict(cls, state: dict) -> "Normaliser":
-        return cls(**{k: tuple(float(x) for x in v) for k, v in state.items()})
+        def exact(x):
+            return tuple(map(float, x)) if isinstance(x, (list, tuple)) else float(x)
+        return cls(**{k: tuple(exact(x) for x in v) for k, v in state.items()})
 
 
 # --------------------------------------------------------------------------- the 144 patterns

@@ -281,6 +281,19 @@ def test_normaliser_state_dict_round_trip(toy):
     assert Normaliser.from_state_dict(state) == norm
 
 
+def test_per_feature_scaling_maps_every_visual_feature_to_unit_range(toy):
+    train = toy.split("train")
+    norm = Normaliser.fit(train, per_feature=True)
+    assert norm.per_feature and not Normaliser.fit(train).per_feature
+    assert len(norm.vision[0]) == len(norm.vision[1]) == train.vision.shape[-1]
+    valid = norm.tensors(train)["vision"][torch.from_numpy(train.mask)]         # (steps, 30)
+    torch.testing.assert_close(valid.min(0).values, -torch.ones(valid.shape[1]), atol=1e-5, rtol=0)
+    torch.testing.assert_close(valid.max(0).values, torch.ones(valid.shape[1]), atol=1e-5, rtol=0)
+    assert norm.joints == Normaliser.fit(train).joints                          # joints as before
+    state = json.loads(json.dumps(norm.state_dict()))
+    assert Normaliser.from_state_dict(state) == norm
+
+
 def test_joints_to_data_inverts(toy):
     norm = Normaliser.fit(toy.split("train"))
     t = norm.tensors(toy)

@@ -281,6 +281,34 @@ def test_decoder_vision_dropout_changes_training_and_stays_deterministic(toy_sho
     assert get_profile("paper").train.decoder_vision_dropout == 0.0
 
 
+def test_hold_first_vision_keeps_the_joints():
+    from pgae_lite.train import hold_first_vision
+    x = torch.randn(3, 9, 35)
+    out = hold_first_vision(x, torch.tensor([False, True, False]))
+    assert torch.equal(out[0], x[0]) and torch.equal(out[2], x[2])        # not chosen: unchanged
+    assert torch.equal(out[1, :, :30], x[1, :1, :30].expand(9, 30))       # chosen: frame 0 at every step
+    assert torch.equal(out[1, :, 30:], x[1, :, 30:])                      # but its own joints
+
+
+def test_encoder_vision_dropout_changes_training_and_stays_deterministic(toy_short):
+    plain = train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu")
+    frozen = [train(toy_short, tiny_profile(epochs=2, encoder_vision_dropout=0.5), progress=False, device="cpu")
+              for _ in range(2)]
+    assert frozen[0].history == frozen[1].history
+    assert frozen[0].history != plain.history
+    assert get_profile("paper").train.encoder_vision_dropout == 0.0
+
+
+def test_per_feature_vision_scaling_is_saved_with_the_model(toy_short, tmp_path):
+    trained = train(toy_short, tiny_profile(epochs=1, vision_scaling="per_feature"), out_dir=tmp_path,
+                    progress=False, device="cpu")
+    assert trained.normaliser.per_feature
+    _, normaliser, _ = load_model(tmp_path / "checkpoint.pt", "cpu")
+    assert normaliser == trained.normaliser
+    with pytest.raises(ValueError, match="global, per_feature"):
+        tiny_profile(vision_scaling="each")
+
+
 def test_weight_decay_uses_adamw(toy_short):
     plain = train(toy_short, tiny_profile(epochs=2, weight_decay=0.0), progress=False, device="cpu")
     decayed = train(toy_short, tiny_profile(epochs=2, weight_decay=0.1), progress=False, device="cpu")
