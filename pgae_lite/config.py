@@ -14,14 +14,12 @@ from __future__ import annotations
 import os
 from dataclasses import asdict, dataclass, field, replace
 
+from .data import VISION_SCALINGS
 from .pgae import ModelConfig
 from .language import SIGNALS
 from .signals import SIGNAL_PROBS
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
-
-
-VISION_SCALINGS = ("global", "per_feature")
 
 
 @dataclass
@@ -70,7 +68,7 @@ class TrainConfig:
     # action and the action from the joints, not from the moved cube's (unfamiliar) end position.
     encoder_vision_dropout: float = 0.0
     # How the visual features are scaled to [-1, 1]: "global" (the authors': one min and max over all
-    # 30 features) or "per_feature" (a min and max for each feature; see data.Normaliser).
+    # 30 features) or "whiten" (whitened first, then one min and max; see data.Normaliser).
     vision_scaling: str = "global"
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β

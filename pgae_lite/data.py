@@ -104,41 +104,81 @@ class PGAEDataset:
         return cls(**arrays, source=source)
 
 
+#: How visual features can be scaled to [-1, 1] (see :meth:`Normaliser.fit`).
+VISION_SCALINGS = ("global", "whiten")
+#: Whitening adds this share of the largest eigenvalue to every eigenvalue before inverting, so
+#: that directions with almost no variance are not blown up.
+WHITENING_EPS = 0.01
+
+
+def whitening(x: np.ndarray, eps: float = WHITENING_EPS) -> tuple[np.ndarray, np.ndarray]:
+    """ZCA whitening of features ``x`` (N, F): the mean (F,) and a matrix W (F, F) such that
+    (x - mean) W has (nearly) the identity as covariance and stays closest to x."""
+    x = x.astype(np.float64)
+    mean = x.mean(0)
+    lam, U = np.linalg.eigh(np.cov(x - mean, rowvar=False))             # C = U diag(λ) Uᵀ
+    return mean, U @ np.diag(1 / np.sqrt(lam + eps * lam.max())) @ U.T  # W = U diag(1/√(λ+ε)) Uᵀ
+
+
 @dataclass
 class Normaliser:
     """Min/max scaling of each modality to [-1, 1] (one global min and max per modality).
 
     Deviation from paper: the authors take min/max over train and test
     together; we use the training split only, so the test set stays unseen.
-    With ``per_feature`` the visual features get a min and max per feature
-    instead (``vision`` then holds two tuples of 30).
+    With ``vision_scaling="whiten"`` the visual features are first whitened
+    (:func:`whitening`, statistics of the training split), then scaled.
     """
 
     joints: tuple[float, float]
-    vision: tuple
-    vision_opposite: tuple
+    vision: tuple[float, float]
+    vision_opposite: tuple[float, float]
+    #: with whitening: {"vision": (mean, W), "vision_opposite": (mean, W)}, as nested tuples
+    whitening: dict | None = None
 
     @classmethod
-    def fit(cls, data: PGAEDataset, per_feature: bool = False) -> "Normaliser":
-        """Statistics from the valid steps of ``data`` (pass the training split)."""
+    def fit(cls, data: PGAEDataset, vision_scaling: str = "global") -> "Normaliser":
+        """Statistics from the valid steps of ``data`` (pass the training split).
+
+        ``vision_scaling``: ``"global"`` (the authors': one min and max over all visual
+        features) or ``"whiten"`` (whitened first: every direction of the 30-d feature
+        space gets the same variance, then one min and max).
+        """
+        if vision_scaling not in VISION_SCALINGS:
+            raise ValueError(f"unknown vision_scaling {vision_scaling!r}; choose one of: {', '.join(VISION_SCALINGS)}")
         m = data.mask
+        white = None
+        if vision_scaling == "whiten":
+            white = {}
+            for key in ("vision", "vision_opposite"):
+                mean, W = whitening(getattr(data, key)[m])
+                white[key] = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
+        norm = cls((0.0, 1.0), (0.0, 1.0), (0.0, 1.0), white)
 
         def lo_hi(x: np.ndarray) -> tuple[float, float]:
             return float(x[m].min()), float(x[m].max())
+        norm.joints = lo_hi(data.joints)
+        norm.vision = lo_hi(norm._whiten(data.vision, "vision"))
+        norm.vision_opposite = lo_hi(norm._whiten(data.vision_opposite, "vision_opposite"))
+        return norm
 
-        def lo_hi_each(x: np.ndarray) -> tuple[tuple[float, ...], tuple[float, ...]]:
-            return tuple(map(float, x[m].min(0))), tuple(map(float, x[m].max(0)))    # (F,), (F,)
-        scale = lo_hi_each if per_feature else lo_hi
-        return cls(lo_hi(data.joints), scale(data.vision), scale(data.vision_opposite))
+    def _whiten(self, x: np.ndarray, key: str) -> np.ndarray:
+        """Visual features ``x`` (..., 30) whitened, if this normaliser whitens (else unchanged)."""
+        if self.whitening is None:
+            return x
+        mean, W = (np.asarray(a) for a in self.whitening[key])
+        return ((x - mean) @ W).astype(np.float32)                          # z = (x - mean) W
 
-    @property
-    def per_feature(self) -> bool:
-        return isinstance(self.vision[0], tuple)
+    def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
+        if self.whitening is None:
+            return self._scale(x, getattr(self, key))
+        lo, hi = (np.float64(v) for v in getattr(self, key))
+        return self._scale(self._whiten(x, key), (lo, hi))
 
     @staticmethod
-    def _scale(x: np.ndarray, lo_hi: tuple) -> np.ndarray:
-        lo, hi = (np.asarray(v, dtype=np.float64) for v in lo_hi)          # scalars, or (F,) per feature
-        return (2.0 * (x - lo) / np.maximum(hi - lo, 1e-12) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
+    def _scale(x: np.ndarray, lo_hi: tuple[float, float]) -> np.ndarray:
+        lo, hi = lo_hi
+        return (2.0 * (x - lo) / (hi - lo) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
 
     def joints_to_model(self, x: np.ndarray) -> np.ndarray:
         """Joints in the data's own units -> the model's [-1, 1]."""
@@ -146,7 +186,7 @@ class Normaliser:
 
     def vision_to_model(self, x: np.ndarray, opposite: bool = False) -> np.ndarray:
         """Visual features (NICO's view, or the opposite agent's) -> the model's [-1, 1]."""
-        return self._scale(x, self.vision_opposite if opposite else self.vision)
+        return self._vision(x, "vision_opposite" if opposite else "vision")
 
     def joints_to_data(self, x: np.ndarray | torch.Tensor) -> np.ndarray | torch.Tensor:
         """Inverse of the joint scaling: [-1, 1] -> the data's own units."""
@@ -158,24 +198,26 @@ class Normaliser:
         m = data.mask[..., None]
         return {
             "joints": torch.from_numpy(self._scale(data.joints, self.joints) * m).to(device),
-            "vision": torch.from_numpy(self._scale(data.vision, self.vision) * m).to(device),
-            "vision_opposite": torch.from_numpy(
-                self._scale(data.vision_opposite, self.vision_opposite) * m).to(device),
+            "vision": torch.from_numpy(self._vision(data.vision, "vision") * m).to(device),
+            "vision_opposite": torch.from_numpy(self._vision(data.vision_opposite, "vision_opposite") * m).to(device),
             "lengths": torch.from_numpy(data.lengths.astype(np.int64)).to(device),
             "descriptions": torch.from_numpy(data.descriptions.astype(np.int64)).to(device),
         }
 
-    def state_dict(self) -> dict[str, list]:
-        def plain(v):
-            return [list(x) if isinstance(x, tuple) else x for x in v]
-        return {"joints": plain(self.joints), "vision": plain(self.vision),
-                "vision_opposite": plain(self.vision_opposite)}
+    def state_dict(self) -> dict:
+        state = {"joints": list(self.joints), "vision": list(self.vision),
+                 "vision_opposite": list(self.vision_opposite)}
+        if self.whitening is not None:
+            state["whitening"] = {k: [list(mean), [list(row) for row in W]] for k, (mean, W) in self.whitening.items()}
+        return state
 
     @classmethod
     def from_state_dict(cls, state: dict) -> "Normaliser":
-        def exact(x):
-            return tuple(map(float, x)) if isinstance(x, (list, tuple)) else float(x)
-        return cls(**{k: tuple(exact(x) for x in v) for k, v in state.items()})
+        white = state.get("whitening")
+        if white is not None:
+            white = {k: (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
+                     for k, (mean, W) in white.items()}
+        return cls(*(tuple(float(x) for x in state[k]) for k in ("joints", "vision", "vision_opposite")), white)
 
 
 # --------------------------------------------------------------------------- the 144 patterns

@@ -120,7 +120,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     train_set = dataset.split("train")
     if cfg.max_train_samples:
         train_set = train_set.subset(slice(0, cfg.max_train_samples))
-    normaliser = Normaliser.fit(train_set, per_feature=cfg.vision_scaling == "per_feature")
+    normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     data = normaliser.tensors(train_set, device)
 
     torch.manual_seed(cfg.seed)

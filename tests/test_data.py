@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data import (MAX_STEPS, DataFormatError, Normaliser, Pattern, PGAEDataset, description_text,
+from pgae_lite.data import (MAX_STEPS, whitening, DataFormatError, Normaliser, Pattern, PGAEDataset, description_text,
                             load_original)
 from pgae_lite.language import ACTIONS, COLOURS, SPEEDS, VOCABULARY, equivalent_descriptions
 
@@ -281,17 +281,24 @@ def test_normaliser_state_dict_round_trip(toy):
     assert Normaliser.from_state_dict(state) == norm
 
 
-def test_per_feature_scaling_maps_every_visual_feature_to_unit_range(toy):
+def test_whitening_decorrelates_the_training_features(toy):
     train = toy.split("train")
-    norm = Normaliser.fit(train, per_feature=True)
-    assert norm.per_feature and not Normaliser.fit(train).per_feature
-    assert len(norm.vision[0]) == len(norm.vision[1]) == train.vision.shape[-1]
-    valid = norm.tensors(train)["vision"][torch.from_numpy(train.mask)]         # (steps, 30)
-    torch.testing.assert_close(valid.min(0).values, -torch.ones(valid.shape[1]), atol=1e-5, rtol=0)
-    torch.testing.assert_close(valid.max(0).values, torch.ones(valid.shape[1]), atol=1e-5, rtol=0)
+    norm = Normaliser.fit(train, "whiten")
+    assert norm.whitening is not None and Normaliser.fit(train).whitening is None
+    x = train.vision[train.mask]                                                 # (steps, 30)
+    mean, W = whitening(x)
+    z = (x - mean) @ W
+    lam = np.linalg.eigvalsh(np.cov(x.astype(np.float64), rowvar=False))     # variances along the principal axes
+    np.testing.assert_allclose(np.linalg.eigvalsh(np.cov(z, rowvar=False)),   # after: λ / (λ + ε λmax), all <= 1
+                               np.sort(lam / (lam + 0.01 * lam.max())), atol=1e-6)
+    valid = norm.tensors(train)["vision"][torch.from_numpy(train.mask)]
+    assert float(valid.min()) == pytest.approx(-1.0, abs=1e-5) and float(valid.max()) == pytest.approx(1.0, abs=1e-5)
+    np.testing.assert_allclose(norm.vision_to_model(x), valid.numpy(), atol=1e-6)   # the same map, one step
     assert norm.joints == Normaliser.fit(train).joints                          # joints as before
     state = json.loads(json.dumps(norm.state_dict()))
     assert Normaliser.from_state_dict(state) == norm
+    with pytest.raises(ValueError, match="global, whiten"):
+        Normaliser.fit(train, "per_feature")
 
 
 def test_joints_to_data_inverts(toy):

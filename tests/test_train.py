@@ -299,13 +299,13 @@ def test_encoder_vision_dropout_changes_training_and_stays_deterministic(toy_sho
     assert get_profile("paper").train.encoder_vision_dropout == 0.0
 
 
-def test_per_feature_vision_scaling_is_saved_with_the_model(toy_short, tmp_path):
-    trained = train(toy_short, tiny_profile(epochs=1, vision_scaling="per_feature"), out_dir=tmp_path,
+def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
+    trained = train(toy_short, tiny_profile(epochs=1, vision_scaling="whiten"), out_dir=tmp_path,
                     progress=False, device="cpu")
-    assert trained.normaliser.per_feature
+    assert trained.normaliser.whitening is not None
     _, normaliser, _ = load_model(tmp_path / "checkpoint.pt", "cpu")
     assert normaliser == trained.normaliser
-    with pytest.raises(ValueError, match="global, per_feature"):
+    with pytest.raises(ValueError, match="global, whiten"):
         tiny_profile(vision_scaling="each")
 
 
