@@ -67,9 +67,11 @@ class TrainConfig:
     # first frame held at every step, so that it learns to take the colours from the scene before the
     # action and the action from the joints, not from the moved cube's (unfamiliar) end position.
     encoder_vision_dropout: float = 0.0
-    # How the visual features are scaled to [-1, 1]: "global" (the authors': one min and max over all
-    # 30 features) or "whiten" (whitened first, then one min and max; see data.Normaliser).
-    vision_scaling: str = "global"
+    # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
+    # see data.Normaliser; authors: "global", one min and max over all 30 features). Measured on our
+    # data (3 seeds, benchmarks/explore_recipe.py --sim): describe 91.7/94.4/90.3% -> 95.4/98.1/93.1%,
+    # execute nRMSE median 0.451 -> 0.453%, repeat action 0.461 -> 0.462%.
+    vision_scaling: str = "whiten"
     language_weight: float = 1.0        # α
     action_weight: float = 1.0          # β
     seed: int = 0
@@ -109,7 +111,7 @@ PROFILES: dict[str, Profile] = {
     "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
         epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
         signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0, input_noise=0.0,
-        weight_decay=0.0,
+        weight_decay=0.0, vision_scaling="global",
         checkpoint_every=100)),
 }
 

@@ -126,15 +126,17 @@ class Normaliser:
 
     Deviation from paper: the authors take min/max over train and test
     together; we use the training split only, so the test set stays unseen.
-    With ``vision_scaling="whiten"`` the visual features are first whitened
-    (:func:`whitening`, statistics of the training split), then scaled.
+    With ``vision_scaling="whiten"`` the visual features of both views are first
+    whitened with one transform (:func:`whitening`, fitted on NICO's own view of
+    the training split, so that one picture means the same numbers in both
+    views), then scaled.
     """
 
     joints: tuple[float, float]
     vision: tuple[float, float]
     vision_opposite: tuple[float, float]
-    #: with whitening: {"vision": (mean, W), "vision_opposite": (mean, W)}, as nested tuples
-    whitening: dict | None = None
+    #: with whitening: (mean, W) as nested tuples, shared by both views
+    whitening: tuple | None = None
 
     @classmethod
     def fit(cls, data: PGAEDataset, vision_scaling: str = "global") -> "Normaliser":
@@ -149,31 +151,29 @@ class Normaliser:
         m = data.mask
         white = None
         if vision_scaling == "whiten":
-            white = {}
-            for key in ("vision", "vision_opposite"):
-                mean, W = whitening(getattr(data, key)[m])
-                white[key] = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
+            mean, W = whitening(data.vision[m])                                   # NICO's view, (30,), (30, 30)
+            white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
         norm = cls((0.0, 1.0), (0.0, 1.0), (0.0, 1.0), white)
 
         def lo_hi(x: np.ndarray) -> tuple[float, float]:
             return float(x[m].min()), float(x[m].max())
         norm.joints = lo_hi(data.joints)
-        norm.vision = lo_hi(norm._whiten(data.vision, "vision"))
-        norm.vision_opposite = lo_hi(norm._whiten(data.vision_opposite, "vision_opposite"))
+        norm.vision = lo_hi(norm._whiten(data.vision))
+        norm.vision_opposite = lo_hi(norm._whiten(data.vision_opposite))
         return norm
 
-    def _whiten(self, x: np.ndarray, key: str) -> np.ndarray:
+    def _whiten(self, x: np.ndarray) -> np.ndarray:
         """Visual features ``x`` (..., 30) whitened, if this normaliser whitens (else unchanged)."""
         if self.whitening is None:
             return x
-        mean, W = (np.asarray(a) for a in self.whitening[key])
+        mean, W = (np.asarray(a) for a in self.whitening)
         return ((x - mean) @ W).astype(np.float32)                          # z = (x - mean) W
 
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
         if self.whitening is None:
             return self._scale(x, getattr(self, key))
         lo, hi = (np.float64(v) for v in getattr(self, key))
-        return self._scale(self._whiten(x, key), (lo, hi))
+        return self._scale(self._whiten(x), (lo, hi))
 
     @staticmethod
     def _scale(x: np.ndarray, lo_hi: tuple[float, float]) -> np.ndarray:
@@ -208,15 +208,16 @@ class Normaliser:
         state = {"joints": list(self.joints), "vision": list(self.vision),
                  "vision_opposite": list(self.vision_opposite)}
         if self.whitening is not None:
-            state["whitening"] = {k: [list(mean), [list(row) for row in W]] for k, (mean, W) in self.whitening.items()}
+            mean, W = self.whitening
+            state["whitening"] = [list(mean), [list(row) for row in W]]
         return state
 
     @classmethod
     def from_state_dict(cls, state: dict) -> "Normaliser":
         white = state.get("whitening")
         if white is not None:
-            white = {k: (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
-                     for k, (mean, W) in white.items()}
+            mean, W = white
+            white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
         return cls(*(tuple(float(x) for x in state[k]) for k in ("joints", "vision", "vision_opposite")), white)
 
 

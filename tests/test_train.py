@@ -54,7 +54,7 @@ def test_learns_a_handful_of_samples(toy_short):
 
 def test_normaliser_from_training_samples_only(toy_short):
     trained = train(toy_short, tiny_profile(epochs=1), progress=False, device="cpu")
-    assert trained.normaliser == Normaliser.fit(toy_short.split("train").subset(slice(0, 12)))
+    assert trained.normaliser == Normaliser.fit(toy_short.split("train").subset(slice(0, 12)), "whiten")
 
 
 def test_history_records(toy_short):
@@ -307,6 +307,8 @@ def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
     assert normaliser == trained.normaliser
     with pytest.raises(ValueError, match="global, whiten"):
         tiny_profile(vision_scaling="each")
+    assert get_profile("book").train.vision_scaling == "whiten"
+    assert get_profile("paper").train.vision_scaling == "global"          # the authors' one min/max
 
 
 def test_weight_decay_uses_adamw(toy_short):
