@@ -25,8 +25,6 @@ ap.add_argument("--threads", type=int, default=2)
 ap.add_argument("--set", nargs="*", default=[], help="TrainConfig overrides key=value")
 ap.add_argument("--model", nargs="*", default=[], help="ModelConfig overrides key=value")
 ap.add_argument("--sim", action="store_true", help="the simulated data (book profile) instead of the authors'")
-ap.add_argument("--whiten", type=float, default=None,
-                help="exploration: ZCA-whiten the visual features (training steps' statistics; eps = this x the largest eigenvalue)")
 ap.add_argument("--log", default=None)
 ap.add_argument("--save", default=None, help="folder for the checkpoint (default: none saved)")
 a = ap.parse_args()
@@ -37,14 +35,6 @@ def overrides(pairs):
 prof = get_profile("book", epochs=a.epochs, seed=a.seed, **overrides(a.set))
 prof.model = replace(prof.model, **overrides(a.model))
 ds = simulated_dataset("book", progress=False) if a.sim else load_original(a.data)
-if a.whiten is not None:
-    import numpy as np
-    tr = ds.split("train")
-    for key in ("vision", "vision_opposite"):
-        x = getattr(tr, key)[tr.mask].astype(np.float64)                         # (steps, 30)
-        mu = x.mean(0); lam, U = np.linalg.eigh(np.cov(x - mu, rowvar=False))
-        W = U @ np.diag(1 / np.sqrt(lam + a.whiten * lam.max())) @ U.T           # ZCA
-        setattr(ds, key, ((getattr(ds, key) - mu) @ W).astype(np.float32))
 t0 = time.perf_counter()
 rows = []
 

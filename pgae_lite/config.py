@@ -63,10 +63,6 @@ class TrainConfig:
     # copy it from the recorded pictures, which a robot acting on its own never has. Off in the book
     # recipe; 0.5 makes the closed loop work (chapter 07) at some cost in nRMSE (README).
     decoder_vision_dropout: float = 0.0
-    # Deviation from paper: the chance that a sample's action encoder (NICO's own view only) reads the
-    # first frame held at every step, so that it learns to take the colours from the scene before the
-    # action and the action from the joints, not from the moved cube's (unfamiliar) end position.
-    encoder_vision_dropout: float = 0.0
     # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
     # see data.Normaliser; authors: "global", one min and max over all 30 features). Measured on our
     # data (3 seeds, benchmarks/explore_recipe.py --sim): describe 91.7/94.4/90.3% -> 95.4/98.1/93.1%,

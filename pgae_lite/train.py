@@ -95,14 +95,6 @@ def hold_first_frame(dec_vision: torch.Tensor, blind: torch.Tensor) -> torch.Ten
     return torch.where(blind[:, None, None], first, dec_vision)
 
 
-def hold_first_vision(action_input: torch.Tensor, frozen: torch.Tensor) -> torch.Tensor:
-    """``action_input`` (B, T, 30 + 5) with the samples where ``frozen`` (B,) is true seeing their first
-    frame at every step; their joints are unchanged."""
-    vision, joints = action_input[..., :-JOINT_DIM], action_input[..., -JOINT_DIM:]   # (B, T, 30), (B, T, 5)
-    held = torch.where(frozen[:, None, None], vision[:, :1].expand_as(vision), vision)
-    return torch.cat([held, joints], 2)
-
-
 def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
           device: torch.device | str | None = None, progress: bool = True,
           model: PGAE | None = None, callback=None) -> Trained:
@@ -170,9 +162,6 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             if cfg.decoder_vision_dropout:
                 blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout
                 batch.dec_vision = hold_first_frame(batch.dec_vision, blind.to(device))
-            if cfg.encoder_vision_dropout:
-                frozen = (torch.rand(size, generator=gen) < cfg.encoder_vision_dropout) & ~opposite
-                batch.action_input = hold_first_vision(batch.action_input, frozen.to(device))
             if cfg.input_noise:  # regularises what the action encoder reads (vision and joints, model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,

@@ -281,24 +281,6 @@ def test_decoder_vision_dropout_changes_training_and_stays_deterministic(toy_sho
     assert get_profile("paper").train.decoder_vision_dropout == 0.0
 
 
-def test_hold_first_vision_keeps_the_joints():
-    from pgae_lite.train import hold_first_vision
-    x = torch.randn(3, 9, 35)
-    out = hold_first_vision(x, torch.tensor([False, True, False]))
-    assert torch.equal(out[0], x[0]) and torch.equal(out[2], x[2])        # not chosen: unchanged
-    assert torch.equal(out[1, :, :30], x[1, :1, :30].expand(9, 30))       # chosen: frame 0 at every step
-    assert torch.equal(out[1, :, 30:], x[1, :, 30:])                      # but its own joints
-
-
-def test_encoder_vision_dropout_changes_training_and_stays_deterministic(toy_short):
-    plain = train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu")
-    frozen = [train(toy_short, tiny_profile(epochs=2, encoder_vision_dropout=0.5), progress=False, device="cpu")
-              for _ in range(2)]
-    assert frozen[0].history == frozen[1].history
-    assert frozen[0].history != plain.history
-    assert get_profile("paper").train.encoder_vision_dropout == 0.0
-
-
 def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
     trained = train(toy_short, tiny_profile(epochs=1, vision_scaling="whiten"), out_dir=tmp_path,
                     progress=False, device="cpu")
