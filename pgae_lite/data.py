@@ -144,7 +144,7 @@ class Normaliser:
 
         ``vision_scaling``: ``"global"`` (the authors': one min and max over all visual
         features) or ``"whiten"`` (whitened first: every direction of the 30-d feature
-        space gets the same variance, then one min and max).
+        space gets about the same variance, then one min and max).
         """
         if vision_scaling not in VISION_SCALINGS:
             raise ValueError(f"unknown vision_scaling {vision_scaling!r}; choose one of: {', '.join(VISION_SCALINGS)}")
@@ -172,7 +172,7 @@ class Normaliser:
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
         if self.whitening is None:
             return self._scale(x, getattr(self, key))
-        lo, hi = (np.float64(v) for v in getattr(self, key))
+        lo, hi = (np.float64(v) for v in getattr(self, key))                # scaled in float64
         return self._scale(self._whiten(x), (lo, hi))
 
     @staticmethod
