@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from dataclasses import asdict, dataclass, field, replace
 
-from .data import VISION_SCALINGS
+from .data import check_vision_scaling
 from .pgae import ModelConfig
 from .language import SIGNALS
 from .signals import SIGNAL_PROBS
@@ -80,8 +80,7 @@ class TrainConfig:
             raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "
                              f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
         self.signal_probs = probs
-        if self.vision_scaling not in VISION_SCALINGS:
-            raise ValueError(f"unknown vision_scaling {self.vision_scaling!r}; choose one of: {', '.join(VISION_SCALINGS)}")
+        check_vision_scaling(self.vision_scaling)
 
 
 @dataclass

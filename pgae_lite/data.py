@@ -120,6 +120,20 @@ def whitening(x: np.ndarray, eps: float = WHITENING_EPS) -> tuple[np.ndarray, np
     return mean, U @ np.diag(1 / np.sqrt(lam + eps * lam.max())) @ U.T  # W = U diag(1/√(λ+ε)) Uᵀ
 
 
+def check_vision_scaling(name: str) -> None:
+    """Raise a ValueError naming the allowed scalings unless ``name`` is one of them."""
+    if name not in VISION_SCALINGS:
+        raise ValueError(f"unknown vision_scaling {name!r}; choose one of: {', '.join(VISION_SCALINGS)}")
+
+
+def _whiten(x: np.ndarray, white: tuple | None) -> np.ndarray:
+    """Visual features ``x`` (..., 30) whitened with ``white = (mean, W)``; unchanged if None."""
+    if white is None:
+        return x
+    mean, W = (np.asarray(a) for a in white)
+    return ((x - mean) @ W).astype(np.float32)                              # z = (x - mean) W
+
+
 @dataclass
 class Normaliser:
     """Min/max scaling of each modality to [-1, 1] (one global min and max per modality).
@@ -146,34 +160,23 @@ class Normaliser:
         features) or ``"whiten"`` (whitened first: every direction of the 30-d feature
         space gets about the same variance, then one min and max).
         """
-        if vision_scaling not in VISION_SCALINGS:
-            raise ValueError(f"unknown vision_scaling {vision_scaling!r}; choose one of: {', '.join(VISION_SCALINGS)}")
+        check_vision_scaling(vision_scaling)
         m = data.mask
         white = None
         if vision_scaling == "whiten":
             mean, W = whitening(data.vision[m])                                   # NICO's view, (30,), (30, 30)
             white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
-        norm = cls((0.0, 1.0), (0.0, 1.0), (0.0, 1.0), white)
 
         def lo_hi(x: np.ndarray) -> tuple[float, float]:
             return float(x[m].min()), float(x[m].max())
-        norm.joints = lo_hi(data.joints)
-        norm.vision = lo_hi(norm._whiten(data.vision))
-        norm.vision_opposite = lo_hi(norm._whiten(data.vision_opposite))
-        return norm
-
-    def _whiten(self, x: np.ndarray) -> np.ndarray:
-        """Visual features ``x`` (..., 30) whitened, if this normaliser whitens (else unchanged)."""
-        if self.whitening is None:
-            return x
-        mean, W = (np.asarray(a) for a in self.whitening)
-        return ((x - mean) @ W).astype(np.float32)                          # z = (x - mean) W
+        return cls(lo_hi(data.joints), lo_hi(_whiten(data.vision, white)),
+                   lo_hi(_whiten(data.vision_opposite, white)), white)
 
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
         if self.whitening is None:
             return self._scale(x, getattr(self, key))
         lo, hi = (np.float64(v) for v in getattr(self, key))                # scaled in float64
-        return self._scale(self._whiten(x), (lo, hi))
+        return self._scale(_whiten(x, self.whitening), (lo, hi))
 
     @staticmethod
     def _scale(x: np.ndarray, lo_hi: tuple[float, float]) -> np.ndarray:
