@@ -26,7 +26,8 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 class TrainConfig:
     """How PGAE is trained. Defaults are the ``book`` recipe."""
 
-    epochs: int = 800
+    # Deviation from paper: 1000 epochs (paper: 6000 at a 500x smaller learning rate).
+    epochs: int = 1000
     batch_size: int = 64
     # Deviation from paper: Adam 2e-3 with warm-up and cosine decay (paper: 1e-5, constant).
     lr: float = 2e-3
@@ -69,7 +70,10 @@ class TrainConfig:
     # execute nRMSE median 0.451 -> 0.453%, repeat action 0.461 -> 0.462%.
     vision_scaling: str = "whiten"
     language_weight: float = 1.0        # α
-    action_weight: float = 1.0          # β
+    # Deviation from paper: β = 2 (paper: 1). The joint error is about 1e-4 of the word loss;
+    # measured on our data (seed 1, benchmarks/explore_recipe.py --sim): 800 epochs, β = 1:
+    # repeat action nRMSE 0.560%; 1000 epochs, β = 2: 0.453%, describe 98.15% either way.
+    action_weight: float = 2.0          # β
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
@@ -106,7 +110,7 @@ PROFILES: dict[str, Profile] = {
     "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
         epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
         signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0, input_noise=0.0,
-        weight_decay=0.0, vision_scaling="global",
+        weight_decay=0.0, vision_scaling="global", action_weight=1.0,
         checkpoint_every=100)),
 }
 

@@ -18,7 +18,8 @@ from pgae_lite.train import CHECKPOINT, load_checkpoint, load_model, lr_factor, 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
     """12 training samples, batches of 4, a few epochs: a second or two of training."""
-    cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1)
+    cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1,
+                  action_weight=1.0)
     return Profile("tiny", ModelConfig(units=units), replace(cfg, **train))
 
 
@@ -185,6 +186,8 @@ def test_profiles():
     paper = get_profile("paper")
     assert paper.model.cell == "peephole" and paper.train.lr == 1e-5 and paper.train.batch_size == 6
     assert paper.train.epochs == 6000 and not paper.train.signals_per_sample
+    assert paper.train.language_weight == paper.train.action_weight == 1.0   # the paper's α = β = 1
+    assert get_profile("book").train.action_weight == 2.0                    # the book's deviation
     p = get_profile("smoke", seed=3, epochs=7)
     assert p.train.seed == 3 and p.train.epochs == 7
     assert PROFILES["smoke"].train.seed == 0 and PROFILES["smoke"].train.epochs == 3   # built-ins untouched
