@@ -36,18 +36,18 @@ paraphrases = load_paraphrases()
 unit = torch.nn.functional.normalize
 similarity = unit(encoder.encode_texts([input_text("execute", p.text) for p in paraphrases]), dim=1) \
     @ unit(encoder.table[rows], dim=1).T                                                     # (108, 288)
-nearest = similarity.argmax(1).tolist()
+cosine, nearest = similarity.max(1)
 
 right = Counter()
 per_action = Counter()
 episodes = []
-for p, k in zip(paraphrases, nearest):
+for p, k, c in zip(paraphrases, nearest.tolist(), cosine.tolist()):
     got = meanings[k]
     slots = {"action": got[0] == p.action, "colour": got[1] == p.colour, "speed": got[2] == p.speed}
     right.update({**slots, "all three": all(slots.values())})
     per_action[p.action] += all(slots.values())
     episodes.append({"text": p.text, "meaning": " ".join(p.meaning), "nearest": encoder.texts[rows[k]],
-                     "cosine": round(float(similarity[len(episodes), k]), 3), "right": all(slots.values())})
+                     "cosine": round(c, 3), "right": all(slots.values())})
 
 n = len(paraphrases)
 summary = {name: round(100 * v / n, 1) for name, v in right.items()}
