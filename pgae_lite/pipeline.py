@@ -87,7 +87,7 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
 
 
 #: Epochs of the chapters' models per profile, where they differ from the profile's own
-#: (``python -m pgae_lite reproduce`` trains the full 800 of the book profile). Three
+#: (``python -m pgae_lite reproduce`` trains the book profile's full 1,200). Three
 #: models are trained while the book builds; 400 epochs each (~5 min on 2 cores) keep the
 #: whole book within half an hour.
 CHAPTER_EPOCHS: dict[str, int] = {"book": 400}

@@ -162,7 +162,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             if cfg.decoder_vision_dropout:
                 blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout
                 batch.dec_vision = hold_first_frame(batch.dec_vision, blind.to(device))
-            if cfg.input_noise:  # regularises what the action encoder reads (vision and joints, model units)
+            if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,
                         feedback="greedy" if cfg.teacher_language else "soft", joint_noise=cfg.joint_noise)

@@ -19,7 +19,7 @@ from pgae_lite.train import CHECKPOINT, load_checkpoint, load_model, lr_factor, 
 def tiny_profile(units: int = 16, **train) -> Profile:
     """12 training samples, batches of 4, a few epochs: a second or two of training."""
     cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1,
-                  action_weight=1.0)
+                  action_weight=1.0, input_noise=0.05, joint_input_noise=None)
     return Profile("tiny", ModelConfig(units=units), replace(cfg, **train))
 
 
@@ -187,7 +187,9 @@ def test_profiles():
     assert paper.model.cell == "peephole" and paper.train.lr == 1e-5 and paper.train.batch_size == 6
     assert paper.train.epochs == 6000 and not paper.train.signals_per_sample
     assert paper.train.language_weight == paper.train.action_weight == 1.0   # the paper's α = β = 1
-    assert get_profile("book").train.action_weight == 2.0                    # the book's deviation
+    book = get_profile("book").train
+    assert book.action_weight == 2.0                                           # the book's deviations
+    assert (book.input_noise, book.joint_input_noise, book.epochs) == (0.1, 0.05, 1200)
     p = get_profile("smoke", seed=3, epochs=7)
     assert p.train.seed == 3 and p.train.epochs == 7
     assert PROFILES["smoke"].train.seed == 0 and PROFILES["smoke"].train.epochs == 3   # built-ins untouched
@@ -250,7 +252,11 @@ def test_input_noise_changes_training_and_stays_deterministic(toy_short):
              for _ in range(2)]
     assert noisy[0].history == noisy[1].history
     assert noisy[0].history != clean.history
-    assert get_profile("paper").train.input_noise == 0.0    # the paper's recipe has none
+    paper = get_profile("paper").train
+    assert paper.input_noise == 0.0 and paper.joint_input_noise is None   # the paper's recipe has none
+    joints_only = train(toy_short, tiny_profile(epochs=2, input_noise=0.0, joint_input_noise=0.05),
+                        progress=False, device="cpu")
+    assert joints_only.history != clean.history                  # noise on the joints alone counts too
 
 
 def test_add_input_noise_separates_vision_and_joints():
