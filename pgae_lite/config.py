@@ -58,7 +58,7 @@ class TrainConfig:
     # Deviation from paper: Gaussian noise of this std on the action encoder's inputs (vision and
     # joints, in model units [-1, 1]) in training. Measured on the authors' data (seed 0, 800
     # epochs): describe 65-87% -> 93%, repeat action nRMSE 0.61-0.72% -> 0.33%. The book uses 0.1 on
-    # the visual features and 0.05 on the joints; measured on our data (4 seeds, 1000 epochs), the
+    # the visual features and 0.05 on the joints; measured on our data (seeds 0-2, 1000 epochs), the
     # vision noise 0.05 -> 0.1 lowered the largest repeat action nRMSE from 0.453 to 0.399%.
     input_noise: float = 0.1
     joint_input_noise: float | None = 0.05   # std on the joints part only; None: input_noise
