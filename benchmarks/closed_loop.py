@@ -36,9 +36,9 @@ ap.add_argument("--out", default="benchmarks/out/closed_loop.json")
 args = ap.parse_args()
 
 torch.set_num_threads(int(os.environ.get("OMP_NUM_THREADS", "1")))
-model, normaliser, ckpt = load_model(args.checkpoint, "cpu")
 cae, _ = trained_cae(args.profile, "cpu", progress=False)
 data = simulated_dataset(args.profile, "cpu", progress=False)
+model, normaliser, ckpt = load_model(args.checkpoint, "cpu", data)   # refuses another cache's features
 
 t0 = time.perf_counter()
 table = compare(model, cae, normaliser, data, limit=args.limit, config=DATASET_PROFILES[args.profile],

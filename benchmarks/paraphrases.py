@@ -49,7 +49,7 @@ torch.set_num_threads(int(os.environ.get("OMP_NUM_THREADS", "1")))
 data = simulated_dataset(args.profile, "cpu", progress=False)
 cae, _ = trained_cae(args.profile, "cpu", progress=False)
 if args.checkpoint:
-    model, normaliser, ckpt = load_model(args.checkpoint, "cpu")
+    model, normaliser, ckpt = load_model(args.checkpoint, "cpu", data)
     model_config = ckpt["profile"]["model"]
 else:
     trained = trained_pgae("PGAE-BERT", args.profile, args.seed, device="cpu")

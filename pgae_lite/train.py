@@ -17,6 +17,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import torch
 from torch import nn
 from tqdm.auto import tqdm
@@ -95,6 +96,16 @@ def hold_first_frame(dec_vision: torch.Tensor, blind: torch.Tensor) -> torch.Ten
     return torch.where(blind[:, None, None], first, dec_vision)
 
 
+class DataMismatchError(ValueError):
+    """A checkpoint is used with data (visual features) other than those it was trained on."""
+
+
+def training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
+    """The samples a training run learns from: the training split, or its first ``max_samples``."""
+    train_set = dataset.split("train")
+    return train_set.subset(slice(0, max_samples)) if max_samples else train_set
+
+
 def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
           device: torch.device | str | None = None, progress: bool = True,
           model: PGAE | None = None, callback=None) -> Trained:
@@ -109,9 +120,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     profile = profile if isinstance(profile, Profile) else get_profile(profile)
     cfg = profile.train
     device = torch.device(device) if device else default_device()
-    train_set = dataset.split("train")
-    if cfg.max_train_samples:
-        train_set = train_set.subset(slice(0, cfg.max_train_samples))
+    train_set = training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     data = normaliser.tensors(train_set, device)
 
@@ -132,6 +141,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             raise CheckpointMismatchError(
                 f"{ckpt_path} was trained with a different profile or seed; use another output "
                 "folder, or delete the checkpoint to start again")
+        check_trained_on(ckpt, normaliser.state_dict(), ckpt_path, dataset.source)
         model.load_state_dict(ckpt["model"])
         optimiser.load_state_dict(ckpt["optimiser"])
         gen.set_state(ckpt["generator"])
@@ -211,14 +221,48 @@ def load_checkpoint(path: str | Path) -> dict:
     return torch.load(path, map_location="cpu", weights_only=True)
 
 
-def load_model(path: str | Path, device: torch.device | str | None = None) -> tuple[PGAE, Normaliser, dict]:
-    """Model (in eval mode), normaliser and the checkpoint's other contents."""
+def _same_numbers(a: list, b: list) -> bool:
+    """Two (nested) lists of floats hold the same numbers, up to rounding."""
+    a, b = (np.hstack([np.ravel(x) for x in v]).astype(float) for v in (a, b))
+    return a.shape == b.shape and bool(np.allclose(a, b))
+
+
+def check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "") -> None:
+    """Raise :class:`DataMismatchError` unless ``fitted`` (a normaliser's state, fitted on the
+    training samples of the data at hand) equals the one saved in ``ckpt``."""
+    saved = ckpt["normaliser"]
+    differ = [k for k in saved if k not in fitted or not _same_numbers(fitted[k], saved[k])]
+    if differ:
+        raise DataMismatchError(
+            f"{path} was not trained on this data ({source or 'dataset'}): the statistics of its training "
+            f"samples ({', '.join(differ)}) differ from those saved with the model. Use the data it was "
+            "trained on: for our simulated data the same cache (PGAE_LITE_CACHE), since the visual features "
+            "come from the cache's CAE and a CAE trained elsewhere (or with another number of threads) gives "
+            "other features; or train the model again on this data (another output folder).")
+
+
+def load_model(path: str | Path, device: torch.device | str | None = None,
+               dataset: PGAEDataset | None = None) -> tuple[PGAE, Normaliser, dict]:
+    """Model (in eval mode), normaliser and the checkpoint's other contents.
+
+    With ``dataset``, first check that the model was trained on it: the
+    normaliser fitted on its training samples must equal the one saved. The
+    visual features come from a CAE, and two CAEs (e.g. trained with another
+    number of threads, in another cache) give different features: a model fed
+    another CAE's features produces nonsense without any error, so this
+    raises :class:`DataMismatchError` instead.
+    """
     ckpt = load_checkpoint(path)
+    if dataset is not None:
+        cfg = ckpt["profile"]["train"]
+        fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
+                                cfg.get("vision_scaling", "global")).state_dict()
+        check_trained_on(ckpt, fitted, path, dataset.source)
     model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["train", "pgae_loss", "CheckpointMismatchError", "Trained", "load_model", "load_checkpoint", "save_checkpoint",
-           "default_device", "lr_factor"]
+__all__ = ["train", "pgae_loss", "CheckpointMismatchError", "DataMismatchError", "Trained", "load_model",
+           "load_checkpoint", "save_checkpoint", "training_split", "default_device", "lr_factor"]

@@ -13,7 +13,7 @@ from pgae_lite.config import PROFILE_ENV, PROFILES, Profile, TrainConfig, get_pr
 from pgae_lite.data import Normaliser
 from pgae_lite.evaluate import predict
 from pgae_lite.pgae import ModelConfig
-from pgae_lite.train import CHECKPOINT, load_checkpoint, load_model, lr_factor, pgae_loss, train
+from pgae_lite.train import CHECKPOINT, DataMismatchError, load_checkpoint, load_model, lr_factor, pgae_loss, train
 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
@@ -300,6 +300,18 @@ def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
         tiny_profile(vision_scaling="each")
     assert get_profile("book").train.vision_scaling == "whiten"
     assert get_profile("paper").train.vision_scaling == "global"          # the authors' one min/max
+
+
+def test_a_model_refuses_data_it_was_not_trained_on(toy_short, tmp_path):
+    train(toy_short, tiny_profile(epochs=1, vision_scaling="whiten"), out_dir=tmp_path, progress=False, device="cpu")
+    load_model(tmp_path / CHECKPOINT, "cpu", toy_short)                    # its own data: accepted
+    other_cae = replace(toy_short, vision=toy_short.vision + 0.01)         # as if another CAE made the features
+    with pytest.raises(DataMismatchError, match="PGAE_LITE_CACHE") as err:
+        load_model(tmp_path / CHECKPOINT, "cpu", other_cae)
+    assert "whitening" in str(err.value)                                # what differs is named
+    with pytest.raises(DataMismatchError, match="another output folder"):  # nor resumes or reuses it
+        train(other_cae, tiny_profile(epochs=1, vision_scaling="whiten"), out_dir=tmp_path, progress=False,
+              device="cpu")
 
 
 def test_weight_decay_uses_adamw(toy_short):
