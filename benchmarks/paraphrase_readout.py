@@ -30,6 +30,7 @@ import itertools
 import json
 import random
 import re
+from collections import Counter
 from pathlib import Path
 
 import torch
@@ -95,10 +96,11 @@ def readout(kind: str, dim: int, classes: int) -> tuple[torch.nn.Module, callabl
     return torch.nn.ModuleList([linear, score]), attend
 
 
-def accuracy(kind: str, train: list[tuple[str, tuple]], test_h, test_m) -> dict[str, float]:
+def accuracy(kind: str, train: list[tuple[str, tuple]], test_h, test_m) -> tuple[dict[str, float], list[dict]]:
+    """Per slot and for all three: % of the held-out paraphrases read right; and the misses."""
     h, m = token_states([t for t, _ in train])
     right = torch.ones(len(held), dtype=torch.bool)
-    out = {}
+    out, misses = {}, []
     for k, (slot, names) in enumerate(SLOTS.items()):
         target = torch.tensor([names.index(mn[k]) for _, mn in train])
         expected = torch.tensor([names.index(p.meaning[k]) for p in held])
@@ -109,11 +111,14 @@ def accuracy(kind: str, train: list[tuple[str, tuple]], test_h, test_m) -> dict[
             torch.nn.functional.cross_entropy(f(h, m), target).backward()
             opt.step()
         with torch.no_grad():
-            ok = f(test_h, test_m).argmax(1) == expected
+            got = f(test_h, test_m).argmax(1)
+        ok = got == expected
         out[slot] = round(100 * ok.float().mean().item(), 1)
+        misses += [{"slot": slot, "text": p.text, "meant": p.meaning[k], "read": names[g]}
+                   for p, g, o in zip(held, got.tolist(), ok.tolist()) if not o]
         right &= ok
     out["all three"] = round(100 * right.float().mean().item(), 1)
-    return out
+    return out, misses
 
 
 test_h, test_m = token_states([p.text for p in held])
@@ -123,9 +128,13 @@ print(f"{'read-out':10s} {'trained on':34s} {'action':>7s} {'colour':>7s} {'spee
 for kind in ("sentence", "tokens"):
     for name, train in (("the 288 instructions", fixed), (f"+ {args.carriers} carrier sentences per meaning",
                                                           fixed + carriers)):
-        r = results[f"{kind} / {name}"] = accuracy(kind, train, test_h, test_m)
+        r, misses = accuracy(kind, train, test_h, test_m)
+        results[f"{kind} / {name}"] = r
         print(f"{kind:10s} {name:34s} {r['action']:7.1f} {r['colour']:7.1f} {r['speed']:7.1f} {r['all three']:10.1f}")
+common = Counter((x["slot"], x["meant"], x["read"]) for x in misses).most_common(6)
+print("the last row's most frequent misses: " + "; ".join(f"{s} {a} read as {b} ({n})" for (s, a, b), n in common))
 Path(args.out).parent.mkdir(parents=True, exist_ok=True)
 Path(args.out).write_text(json.dumps({"model": encoder.name, "carriers": args.carriers, "results": results,
+                                      "misses_of_last_row": misses,
                                       "examples": [t for t, _ in carriers[::97]]}, indent=1))
 print(f"e.g. {carriers[0][0]!r}, {carriers[-1][0]!r}\nwritten to {args.out}")
