@@ -141,7 +141,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             raise CheckpointMismatchError(
                 f"{ckpt_path} was trained with a different profile or seed; use another output "
                 "folder, or delete the checkpoint to start again")
-        check_trained_on(ckpt, normaliser.state_dict(), ckpt_path, dataset.source)
+        _check_trained_on(ckpt, normaliser.state_dict(), ckpt_path, dataset.source)
         model.load_state_dict(ckpt["model"])
         optimiser.load_state_dict(ckpt["optimiser"])
         gen.set_state(ckpt["generator"])
@@ -227,7 +227,7 @@ def _same_numbers(a: list, b: list) -> bool:
     return a.shape == b.shape and bool(np.allclose(a, b))
 
 
-def check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "") -> None:
+def _check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "") -> None:
     """Raise :class:`DataMismatchError` unless ``fitted`` (a normaliser's state, fitted on the
     training samples of the data at hand) equals the one saved in ``ckpt``."""
     saved = ckpt["normaliser"]
@@ -257,7 +257,7 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         cfg = ckpt["profile"]["train"]
         fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
-        check_trained_on(ckpt, fitted, path, dataset.source)
+        _check_trained_on(ckpt, fitted, path, dataset.source)
     model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
