@@ -100,7 +100,7 @@ class DataMismatchError(ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
 
-def training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
+def _training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
     """The samples a training run learns from: the training split, or its first ``max_samples``."""
     train_set = dataset.split("train")
     return train_set.subset(slice(0, max_samples)) if max_samples else train_set
@@ -120,7 +120,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     profile = profile if isinstance(profile, Profile) else get_profile(profile)
     cfg = profile.train
     device = torch.device(device) if device else default_device()
-    train_set = training_split(dataset, cfg.max_train_samples)
+    train_set = _training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     data = normaliser.tensors(train_set, device)
 
@@ -255,7 +255,7 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
     ckpt = load_checkpoint(path)
     if dataset is not None:
         cfg = ckpt["profile"]["train"]
-        fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
+        fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         _check_trained_on(ckpt, fitted, path, dataset.source)
     model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
@@ -265,4 +265,4 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
 
 
 __all__ = ["train", "pgae_loss", "CheckpointMismatchError", "DataMismatchError", "Trained", "load_model",
-           "load_checkpoint", "save_checkpoint", "training_split", "default_device", "lr_factor"]
+           "load_checkpoint", "save_checkpoint", "default_device", "lr_factor"]
