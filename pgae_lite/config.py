@@ -68,6 +68,10 @@ class TrainConfig:
     # copy it from the recorded pictures, which a robot acting on its own never has. Off in the book
     # recipe; 0.5 makes the closed loop work (chapter 07) at some cost in nRMSE (README).
     decoder_vision_dropout: float = 0.0
+    # Deviation from paper: the action decoder reads its frames replayed at a random speed in
+    # [1 - w, 1 + w] per sample (train.warp_time), so frames that lag or lead the motion teach it to
+    # correct, not to copy, the arm it sees. Off in the book recipe; see chapter 07.
+    decoder_vision_warp: float = 0.0
     # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
     # see data.Normaliser; authors: "global", one min and max over all 30 features). Measured on our
     # data (3 seeds, benchmarks/explore_recipe.py --sim): describe 91.7/94.4/90.3% -> 95.4/98.1/93.1%,

@@ -96,6 +96,20 @@ def hold_first_frame(dec_vision: torch.Tensor, blind: torch.Tensor) -> torch.Ten
     return torch.where(blind[:, None, None], first, dec_vision)
 
 
+def warp_time(dec_vision: torch.Tensor, speed: torch.Tensor, joint_mask: torch.Tensor) -> torch.Tensor:
+    """``dec_vision`` (B, T-1, 30) replayed at ``speed`` (B,): step t reads frame round(speed * t).
+
+    A speed below 1 shows the decoder frames that lag the motion it must produce, above 1 frames
+    that lead it (held at the sample's last valid frame, ``joint_mask`` (B, T-1)); the targets stay.
+    So it learns to catch up with a lagging arm instead of copying the lag, which is what a robot
+    that sees its own motion needs (the closed loop, chapter 07).
+    """
+    steps = torch.arange(dec_vision.shape[1], device=dec_vision.device)             # (T-1,)
+    last = (joint_mask.sum(1) - 1).clamp(min=0)                                     # (B,) last valid frame
+    index = torch.minimum((speed[:, None] * steps).round().long(), last[:, None])   # (B, T-1)
+    return dec_vision.gather(1, index[..., None].expand_as(dec_vision))            # (B, T-1, 30)
+
+
 class DataMismatchError(ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
@@ -172,6 +186,9 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             if cfg.decoder_vision_dropout:
                 blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout
                 batch.dec_vision = hold_first_frame(batch.dec_vision, blind.to(device))
+            if cfg.decoder_vision_warp:
+                speed = 1 + cfg.decoder_vision_warp * (2 * torch.rand(size, generator=gen) - 1)
+                batch.dec_vision = warp_time(batch.dec_vision, speed.to(device), batch.joint_mask)
             if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
             out = model(batch, teacher_language=cfg.teacher_language, teacher_joints=teacher_joints,

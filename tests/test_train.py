@@ -281,13 +281,29 @@ def test_hold_first_frame_only_for_the_blind_samples():
         assert torch.equal(out[b], vision[b, :1].expand(9, 30))            # chosen: frame 0 at every step
 
 
-def test_decoder_vision_dropout_changes_training_and_stays_deterministic(toy_short):
+def test_warp_time_replays_the_frames_slower_or_faster_within_each_sample():
+    from pgae_lite.train import hold_first_frame, warp_time
+    vision = torch.arange(8.)[None, :, None].expand(2, 8, 30).clone()      # frame t holds the number t
+    mask = torch.tensor([[True] * 8, [True] * 5 + [False] * 3])             # sample 1: 5 valid steps
+    frame = lambda out: out[..., 0].long().tolist()                         # noqa: E731
+    same = warp_time(vision, torch.tensor([1.0, 1.0]), mask)
+    assert torch.equal(same[0], vision[0]) and torch.equal(same[1, :5], vision[1, :5])
+    assert frame(warp_time(vision, torch.tensor([0.5, 2.0]), mask)) == [[0, 0, 1, 2, 2, 2, 3, 4],
+                                                                        [0, 2, 4, 4, 4, 4, 4, 4]]
+    still = warp_time(vision, torch.tensor([0.0, 0.0]), mask)               # speed 0: the first frame held
+    assert torch.equal(still, hold_first_frame(vision, torch.tensor([True, True])))
+
+
+@pytest.mark.parametrize("augmentation", [{"decoder_vision_dropout": 0.5}, {"decoder_vision_warp": 0.5}])
+def test_decoder_vision_augmentations_change_training_and_stay_deterministic(toy_short, augmentation):
     plain = train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu")
-    blind = [train(toy_short, tiny_profile(epochs=2, decoder_vision_dropout=0.5), progress=False, device="cpu")
-             for _ in range(2)]
-    assert blind[0].history == blind[1].history
-    assert blind[0].history != plain.history
-    assert get_profile("paper").train.decoder_vision_dropout == 0.0
+    changed = [train(toy_short, tiny_profile(epochs=2, **augmentation), progress=False, device="cpu")
+               for _ in range(2)]
+    assert changed[0].history == changed[1].history
+    assert changed[0].history != plain.history
+    book, paper = get_profile("book").train, get_profile("paper").train
+    assert paper.decoder_vision_dropout == paper.decoder_vision_warp == 0.0
+    assert book.decoder_vision_dropout == book.decoder_vision_warp == 0.0
 
 
 def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
