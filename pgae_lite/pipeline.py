@@ -98,7 +98,8 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     """A model of Table 1 trained on the profile's simulated data: loaded from the cache if trained before.
 
     ``training`` is one of :data:`pgae_lite.reproduce.TRAININGS` (``"PGAE"``,
-    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
+    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite, ``"PGAE-closed"`` for
+    the closed loop);
     ``train_overrides`` change the profile's training options (e.g. ``epochs=60``).
     Without ``epochs``, a profile named in :data:`CHAPTER_EPOCHS` trains that many.
     An interrupted training resumes from its last checkpoint.
