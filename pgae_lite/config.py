@@ -66,11 +66,12 @@ class TrainConfig:
     # Deviation from paper: the chance that a sample's action decoder reads the first frame held at
     # every step instead of the recorded frames, so that it must plan the motion from h and cannot
     # copy it from the recorded pictures, which a robot acting on its own never has. Off in the book
-    # recipe; 0.5 makes the closed loop work (chapter 07) at some cost in nRMSE (README).
+    # recipe; 0.5, with decoder_vision_warp 0.5, is the training PGAE-closed (reproduce.TRAININGS),
+    # which executes in closed loop at some cost in Table 1's nRMSE (chapter 07, README).
     decoder_vision_dropout: float = 0.0
     # Deviation from paper: the action decoder reads its frames replayed at a random speed in
     # [1 - w, 1 + w] per sample (train.warp_time), so frames that lag or lead the motion teach it to
-    # correct, not to copy, the arm it sees. Off in the book recipe; see chapter 07.
+    # correct, not to copy, the arm it sees. Off in the book recipe; 0.5 in PGAE-closed.
     decoder_vision_warp: float = 0.0
     # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
     # see data.Normaliser; authors: "global", one min and max over all 30 features). Measured on our
@@ -92,6 +93,9 @@ class TrainConfig:
             raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "
                              f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
         self.signal_probs = probs
+        for name in ("decoder_vision_dropout", "decoder_vision_warp"):
+            if not 0.0 <= getattr(self, name) <= 1.0:
+                raise ValueError(f"{name} must lie between 0 and 1 (0: off); got {getattr(self, name)}")
         check_vision_scaling(self.vision_scaling)
 
 

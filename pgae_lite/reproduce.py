@@ -11,8 +11,9 @@ Paper, Sec. 4 and Table 1. Four rows come from three trainings::
 
 ``execute`` and ``repeat language`` show no action to the encoder beyond the
 first step, so PGAE-opposite shares those two cells with PGAE-self (as in the
-paper). A fourth training, ``PGAE-closed``, is no row of the table: it is the
-model chapter 07 lets drive the robot with its own camera (the closed loop). With several seeds every cell is reported as mean ± standard deviation.
+paper). With several seeds every cell is reported as mean ± standard deviation.
+A fourth training, ``PGAE-closed``, is no row of the table: it is the model
+made to drive the robot with its own camera (the closed loop, chapter 07).
 
 Output folder layout (``out``)::
 

@@ -304,6 +304,9 @@ def test_decoder_vision_augmentations_change_training_and_stay_deterministic(toy
     book, paper = get_profile("book").train, get_profile("paper").train
     assert paper.decoder_vision_dropout == paper.decoder_vision_warp == 0.0
     assert book.decoder_vision_dropout == book.decoder_vision_warp == 0.0
+    name = next(iter(augmentation))
+    with pytest.raises(ValueError, match=f"{name} must lie between 0 and 1"):
+        tiny_profile(**{name: 1.5})
 
 
 def test_whitening_is_saved_with_the_model(toy_short, tmp_path):
