@@ -95,7 +95,9 @@ CHAPTER_EPOCHS: dict[str, int] = {"book": 400}
 
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
-    """A model of one training (a row of Table 1, or PGAE-closed) trained on the profile's simulated data: loaded from the cache if trained before.
+    """A model of one training (a row of Table 1, or PGAE-closed) on the profile's simulated data, cached.
+
+    Loaded from the cache if it was trained before.
 
     ``training`` is one of :data:`pgae_lite.reproduce.TRAININGS` (``"PGAE"``,
     ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite, ``"PGAE-closed"`` for
