@@ -86,6 +86,13 @@ class TrainConfig:
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
+    expected_language_loss: bool = False
+    ema: float = 0.0
+    augment_execute_only: bool = False
+    length_batches: bool = False
+    noise_on_first_step_signals: bool = True
+    decoder_weight_decay: float | None = None
+    bf16: bool = False                  # the fused LSTMs' matmuls in bfloat16 on the CPU (training only)
 
     def __post_init__(self):
         probs = tuple(float(q) for q in self.signal_probs)

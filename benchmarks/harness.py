@@ -1,0 +1,106 @@
+"""The one harness every benchmark uses: a common command line and one result format.
+
+    from harness import Benchmark             # benchmarks/ is on sys.path when a script there runs
+
+    bench = Benchmark("table1", __doc__)      # --threads, --out, --profile, --seeds, --quick
+    bench.parser.add_argument("--rows", default="PGAE")
+    args = bench.parse()                      # sets torch's threads once, here
+    ...
+    bench.write({"rows": ...})                # results/table1.json (or --out)
+
+A result file is JSON::
+
+    {"benchmark": "table1", "command": "python benchmarks/table1.py --seeds 0 1 2",
+     "commit": "1a2b3c4 (+ uncommitted changes)", "date": "2026-11-24T15:02:11+00:00",
+     "machine": {"cpu": "AMD EPYC", "cores": 2, "gpu": null, "torch": "2.13.0+cpu", "threads": 2},
+     "profile": "book", "seeds": [0, 1, 2], "seconds": 1234.5, "data": {...}}
+
+``data`` is whatever the benchmark measured; the book, the README and the
+tests read every quoted figure from these files (:mod:`pgae_lite.results`).
+Files are written atomically, NaN refused (``allow_nan=False``): a result is
+valid JSON or is not written.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "results"
+
+
+def commit() -> str:
+    """The checkout's commit, marked when the tree has uncommitted changes (outside results/)."""
+    def git(*a: str) -> str:
+        return subprocess.run(["git", *a], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    head = git("rev-parse", "--short", "HEAD") or "unknown"
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!results")
+    return head + (" (+ uncommitted changes)" if dirty else "")
+
+
+def machine(threads: int | None = None) -> dict:
+    """What the figures were measured on."""
+    import torch
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        cpu = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    gpu = torch.cuda.get_device_name(0) if torch.cuda.is_available() else None
+    return {"cpu": cpu, "cores": os.cpu_count(), "gpu": gpu, "torch": torch.__version__,
+            "threads": threads or torch.get_num_threads()}
+
+
+class Benchmark:
+    """Command line and result file of one benchmark named ``name``."""
+
+    def __init__(self, name: str, doc: str | None = None, seeds: list[int] | None = None):
+        self.name, self.t0 = name, time.perf_counter()
+        self.parser = argparse.ArgumentParser(description=doc,
+                                              formatter_class=argparse.RawDescriptionHelpFormatter)
+        self.parser.add_argument("--threads", type=int, default=None,
+                                 help="torch threads per process (default: torch's, one per core)")
+        self.parser.add_argument("--out", default=None, help=f"result file (default: results/{name}.json)")
+        self.parser.add_argument("--profile", default="book", help="the recipe's profile (default: book)")
+        self.parser.add_argument("--seeds", type=int, nargs="+", default=seeds or [0], help="seeds to run")
+        self.args: argparse.Namespace | None = None
+
+    def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
+        self.args = self.parser.parse_args(argv)
+        if self.args.threads:
+            import torch
+
+            torch.set_num_threads(self.args.threads)
+            os.environ["OMP_NUM_THREADS"] = str(self.args.threads)   # for the processes it starts
+        return self.args
+
+    @property
+    def path(self) -> Path:
+        return Path(self.args.out) if self.args and self.args.out else RESULTS / f"{self.name}.json"
+
+    def write(self, data: dict, **fields) -> Path:
+        """``data`` with the command, commit, date and machine, to :attr:`path` (atomically)."""
+        args = self.args or argparse.Namespace(profile=None, seeds=None, threads=None)
+        report = {"benchmark": self.name,
+                  "command": " ".join(["python", shlex.quote(os.path.relpath(sys.argv[0], ROOT))]
+                                      + [shlex.quote(a) for a in sys.argv[1:]]),
+                  "commit": commit(),
+                  "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+                  "machine": machine(args.threads), "profile": args.profile, "seeds": args.seeds,
+                  "seconds": round(time.perf_counter() - self.t0, 1), **fields, "data": data}
+        path = self.path
+        path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+        tmp.write_text(json.dumps(report, indent=1, allow_nan=False) + "\n")
+        os.replace(tmp, path)
+        print(f"written to {os.path.relpath(path)}")
+        return path
