@@ -90,6 +90,7 @@ class TrainConfig:
     ema: float = 0.0
     augment_execute_only: bool = False
     length_batches: bool = False
+    augment_ramp: float = 0.0
     noise_on_first_step_signals: bool = True
     decoder_weight_decay: float | None = None
     bf16: bool = False                  # the fused LSTMs' matmuls in bfloat16 on the CPU (training only)

@@ -218,13 +218,14 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
             opposite &= signal != EXECUTE  # execute shows no action to the encoder
             batch = make_batch(data, index, signal, alternative, opposite)
+            ramp = min(1.0, step / (cfg.augment_ramp * total)) if cfg.augment_ramp else 1.0
             if cfg.decoder_vision_dropout:
-                blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout
+                blind = torch.rand(size, generator=gen) < cfg.decoder_vision_dropout * ramp
                 if cfg.augment_execute_only:
                     blind &= signal == EXECUTE
                 batch.dec_vision = hold_first_frame(batch.dec_vision, blind.to(device))
             if cfg.decoder_vision_warp:
-                speed = 1 + cfg.decoder_vision_warp * (2 * torch.rand(size, generator=gen) - 1)
+                speed = 1 + cfg.decoder_vision_warp * ramp * (2 * torch.rand(size, generator=gen) - 1)
                 if cfg.augment_execute_only:
                     speed = torch.where(signal == EXECUTE, speed, torch.ones_like(speed))
                 batch.dec_vision = warp_time(batch.dec_vision, speed.to(device), batch.joint_mask)
