@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.command == "reproduce":
         from .data import DataFormatError
         from .reproduce import parse_rows, reproduce
-        from .train import CheckpointMismatchError
+        from .utils import CheckpointMismatchError
 
         try:
             rows = parse_rows(args.rows)

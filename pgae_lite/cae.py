@@ -37,7 +37,7 @@ from torch import nn
 from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
-from .train import CheckpointMismatchError, default_device
+from .utils import CheckpointMismatchError, atomic_path, default_device
 
 HEIGHT, WIDTH = 120, 160
 COLOURS = ("red", "green", "blue")
@@ -288,10 +288,9 @@ def train_cae(images: np.ndarray, config: CAEConfig | str | None = None, device:
     if out_path is not None:
         out_path = Path(out_path)
         out_path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out_path.with_name(out_path.name + ".tmp")
-        torch.save({"model": model.state_dict(), "config": config.to_dict(), "data": data, "history": history,
-                    "seconds": time.perf_counter() - t0}, tmp)
-        os.replace(tmp, out_path)  # atomic: a crash never leaves half a file
+        with atomic_path(out_path) as tmp:   # a crash never leaves half a file
+            torch.save({"model": model.state_dict(), "config": config.to_dict(), "data": data,
+                        "history": history, "seconds": time.perf_counter() - t0}, tmp)
     return model, history
 
 

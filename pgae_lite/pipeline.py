@@ -14,8 +14,6 @@ earlier chapter (or ``python -m pgae_lite simulate``) already made:
 """
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 import warnings
 from pathlib import Path
@@ -24,7 +22,8 @@ from typing import TYPE_CHECKING
 from .cae import (CAEConfig, ChannelSeparatedCAE, extract_features, get_cae_config, load_cae,
                   train_cae)
 from .data import DataFormatError, PGAEDataset
-from .simdata import DATASET_PROFILES, DatasetConfig, cache_dir, generate, to_dataset, training_frames
+from .simdata import DATASET_PROFILES, DatasetConfig, generate, to_dataset, training_frames
+from .utils import cache_dir, config_digest
 
 if TYPE_CHECKING:
     from .train import Trained
@@ -40,13 +39,14 @@ def profile_name(profile: str | None = None) -> str:
     return name
 
 
-def _key(config: CAEConfig) -> str:
-    return hashlib.sha1(json.dumps(config.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+def _stem(data: DatasetConfig, cae: CAEConfig) -> str:
+    """The cache name of the episodes of ``data`` seen through a CAE trained with ``cae``: two digests."""
+    return f"{data.key()}-{config_digest(cae.to_dict())}"
 
 
 def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
     """Where the CAE trained on ``data`` with ``cae`` is cached."""
-    return cache_dir() / "cae" / f"{data.key()}-{_key(cae)}.pt"
+    return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
 
 
 def trained_cae(profile: str | None = None, device: str | None = None, progress: bool = True,
@@ -73,7 +73,7 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
     """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
     name = profile_name(profile)
     data, cae_config = DATASET_PROFILES[name], get_cae_config(name)
-    path = cache_dir() / "features" / f"{data.key()}-{_key(cae_config)}.npz"
+    path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
     if path.exists():
         try:
             return PGAEDataset.load(path)
@@ -117,8 +117,8 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
         train_overrides.setdefault("epochs", CHAPTER_EPOCHS[name])
     dataset = simulated_dataset(name, device, progress)
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
-    key = hashlib.sha1(json.dumps(prof.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
-    folder = cache_dir() / "pgae" / f"{DATASET_PROFILES[name].key()}-{_key(get_cae_config(name))}-{training}-{key}"
+    stem = _stem(DATASET_PROFILES[name], get_cae_config(name))
+    folder = cache_dir() / "pgae" / f"{stem}-{training}-{config_digest(prof.to_dict())}"
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 

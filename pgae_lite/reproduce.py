@@ -25,7 +25,6 @@ Output folder layout (``out``)::
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import statistics
 import time
@@ -39,6 +38,7 @@ from .data import PGAEDataset
 from .evaluate import PAPER_TABLE, Predictions, evaluate, format_table
 from .language import TEST_SIGNALS
 from .train import train
+from .utils import atomic_write
 
 
 @dataclass(frozen=True)
@@ -105,9 +105,8 @@ def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
         arrays[f"{key}_ids"] = p.ids.astype(str)
         arrays[f"{key}_text"] = np.asarray(p.text, dtype=str)
         arrays[f"{key}_joints"] = p.joints
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, path)
+    with atomic_write(path) as f:
+        np.savez_compressed(f, **arrays)
 
 
 def summarise(per_seed: list[dict[str, dict[str, float]]]) -> tuple[dict, dict]:

@@ -12,7 +12,6 @@ CPU run round sums differently and drift apart), runs on CUDA when present
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,17 +27,9 @@ from .language import SIGNALS, word_weights
 from .layers import bfloat16_recurrence
 from .pgae import PGAE, ModelConfig
 from .signals import ACTION_IN, EXECUTE, SignalBatch, make_batch, sample_signals
+from .utils import CheckpointMismatchError, atomic_path, default_device
 
 CHECKPOINT = "checkpoint.pt"
-
-
-class CheckpointMismatchError(ValueError):
-    """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
-
-
-def default_device() -> torch.device:
-    """CUDA when present, else the CPU."""
-    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
 
 
 def pgae_loss(out: dict[str, torch.Tensor], batch: SignalBatch, weights: torch.Tensor,
@@ -286,12 +277,11 @@ def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, g
                     seconds: float) -> None:
     """Write a checkpoint atomically (a crash mid-write never leaves a broken file)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
-                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
-                "history": history, "profile": profile.to_dict(),
-                "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:
+        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
+                    "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
+                    "history": history, "profile": profile.to_dict(),
+                    "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
 
 
 def load_checkpoint(path: str | Path) -> dict:
@@ -342,5 +332,5 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["train", "pgae_loss", "CheckpointMismatchError", "DataMismatchError", "Trained", "load_model",
-           "load_checkpoint", "save_checkpoint", "default_device", "lr_factor"]
+__all__ = ["train", "pgae_loss", "DataMismatchError", "Trained", "load_model", "load_checkpoint",
+           "save_checkpoint", "lr_factor"]

@@ -16,7 +16,7 @@ from pgae_lite.cae import (
     reconstruct,
     train_cae,
 )
-from pgae_lite.train import CheckpointMismatchError
+from pgae_lite.utils import CheckpointMismatchError
 
 TINY = CAEConfig("tiny", batch_size=4, iterations=3, seed=0)
 
