@@ -15,11 +15,33 @@ import os
 from dataclasses import asdict, dataclass, field, replace
 
 from .data import check_vision_scaling
-from .pgae import ModelConfig
 from .language import SIGNALS
 from .signals import SIGNAL_PROBS
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
+
+
+@dataclass
+class ModelConfig:
+    """Architecture of PGAE (:class:`pgae_lite.pgae.PGAE`). Defaults are the ``book`` recipe.
+
+    Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50.
+    """
+
+    units: int = 100
+    layers: int = 2
+    hidden: int = 50
+    cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
+    # Deviation from paper: "start" = the action decoder reads the start joints at every step instead of
+    # its own previous prediction ("predicted", the paper's; see pgae.ActionDecoder).
+    joint_feedback: str = "start"
+    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py).
+    language_encoder: str = "lstm"
+    pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
+
+    @property
+    def state_dim(self) -> int:
+        return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
 
 @dataclass
@@ -118,15 +140,11 @@ class Profile:
         return {"name": self.name, "model": asdict(self.model), "train": asdict(self.train)}
 
 
-# Deviation from paper (book and smoke): the action decoder reads the start joints at every
-# step instead of its own previous prediction (ModelConfig.joint_feedback, see pgae.ActionDecoder).
-BOOK_MODEL = ModelConfig(joint_feedback="start")
-
 PROFILES: dict[str, Profile] = {
-    "smoke": Profile("smoke", replace(BOOK_MODEL, units=32), TrainConfig(
+    "smoke": Profile("smoke", ModelConfig(units=32), TrainConfig(
         epochs=3, batch_size=32, lr=3e-3, max_train_samples=96, checkpoint_every=1)),
-    "book": Profile("book", BOOK_MODEL),
-    "paper": Profile("paper", ModelConfig(cell="peephole"), TrainConfig(
+    "book": Profile("book", ModelConfig()),
+    "paper": Profile("paper", ModelConfig(cell="peephole", joint_feedback="predicted"), TrainConfig(
         epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
         signals_per_sample=False, teacher_language=False, teacher_joints_until=0.0, input_noise=0.0,
         joint_input_noise=None,

@@ -21,11 +21,11 @@ import torch
 from torch import nn
 from tqdm.auto import tqdm
 
-from .config import Profile, get_profile
+from .config import ModelConfig, Profile, get_profile
 from .data import JOINT_DIM, Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .layers import bfloat16_recurrence
-from .pgae import PGAE, ModelConfig
+from .pgae import PGAE
 from .signals import ACTION_IN, EXECUTE, SignalBatch, make_batch, sample_signals
 from .utils import CheckpointMismatchError, atomic_path, default_device
 
@@ -326,7 +326,8 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         _check_trained_on(ckpt, fitted, path, dataset.source)
-    model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
+    # Checkpoints older than ModelConfig.joint_feedback were trained with the paper's feedback.
+    model = PGAE(ModelConfig(**{"joint_feedback": "predicted", **ckpt["profile"]["model"]}))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
