@@ -26,8 +26,8 @@ import time
 import torch
 
 from pgae_lite.closedloop import compare, success_summary
+from pgae_lite.config import get_profile
 from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import load_model
 
 from _report import write_report   # benchmarks/_report.py (the script's folder is on sys.path)
@@ -46,7 +46,7 @@ data = simulated_dataset(args.profile, "cpu", progress=False)
 model, normaliser, ckpt = load_model(args.checkpoint, "cpu", data)   # refuses another cache's features
 
 t0 = time.perf_counter()
-table = compare(model, cae, normaliser, data, limit=args.limit, config=DATASET_PROFILES[args.profile],
+table = compare(model, cae, normaliser, data, limit=args.limit, config=get_profile(args.profile).data,
                 tracking=not args.no_tracking)
 seconds = time.perf_counter() - t0
 summary = success_summary(table)

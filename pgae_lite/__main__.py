@@ -20,10 +20,10 @@ ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
     """Record the profile's simulated dataset (or complete it) and print what was done."""
-    from .simdata import DATASET_PROFILES, generate
+    from .config import get_profile
+    from .simdata import generate
 
-    name = profile or os.environ.get(PROFILE_ENV, "book")
-    report = generate(DATASET_PROFILES[name], workers=workers, progress=progress)
+    report = generate(get_profile(profile).data, workers=workers, progress=progress)
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
           f"in {report.seconds:.1f} s, {report.corrupt} damaged files replaced; "
           f"valid on the first try: {100 * report.first_try:.1f}%")

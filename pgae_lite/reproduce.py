@@ -94,7 +94,7 @@ def training_profile(base: Profile, training: str, pretrained_model: str | None 
     model = replace(base.model, **t.model)
     if training == "PGAE-BERT" and pretrained_model:
         model = replace(model, pretrained_model=pretrained_model)
-    return Profile(base.name, model, replace(base.train, **t.train))
+    return replace(base, model=model, train=replace(base.train, **t.train))
 
 
 def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:

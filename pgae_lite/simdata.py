@@ -70,16 +70,6 @@ class DatasetConfig:
         return config_digest({"version": GENERATOR_VERSION, **asdict(self)})
 
 
-#: Two arrangements (0: red+blue, 7: cyan+yellow), every action at both speeds;
-#: 10 of these 24 patterns are test patterns.
-SMOKE_PATTERNS = tuple(sorted(72 * s + 6 * a + i for s in (0, 1) for a in (0, 7) for i in range(6)))
-DATASET_PROFILES: dict[str, DatasetConfig] = {
-    "smoke": DatasetConfig(variations=1, patterns=SMOKE_PATTERNS),
-    "book": DatasetConfig(),
-    "paper": DatasetConfig(),
-}
-
-
 class CorruptEpisodeError(RuntimeError):
     """A cached episode file is damaged or does not match what was recorded."""
 
@@ -198,7 +188,7 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
     spawned, so a script that calls this needs the usual ``if __name__ == "__main__":`` guard.
     Safe to interrupt and to call again; damaged files are recorded again.
     """
-    config = config or DATASET_PROFILES["book"]
+    config = config or DatasetConfig()          # the book's (its profiles: pgae_lite.config)
     t0 = time.perf_counter()
     folder = episode_folder(config)
     folder.mkdir(parents=True, exist_ok=True)
@@ -292,6 +282,6 @@ def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarra
                            source=f"simulated:{config.key()}")
 
 
-__all__ = ["DatasetConfig", "DATASET_PROFILES", "SMOKE_PATTERNS", "GenerationReport", "CorruptEpisodeError",
+__all__ = ["DatasetConfig", "GenerationReport", "CorruptEpisodeError",
            "generate", "load_episode", "iter_episodes", "training_frames", "to_dataset",
            "episode_folder", "save_episode", "load_episode_file"]
