@@ -13,7 +13,7 @@ takes N episodes evenly spread over the 216 of the test split. Run it with
 ``OMP_NUM_THREADS=1``: the models are small, a second thread does not help.
 
 The book's PGAE copies from the recorded pictures and drifts in closed loop;
-the training ``PGAE-closed`` (``pgae_lite.reproduce.TRAININGS``) is the one
+the training ``PGAE-closed`` (``pgae_lite.config.TRAININGS``) is the one
 made for it, e.g. ``python benchmarks/explore_recipe.py --sim --epochs 1200
 --set decoder_vision_dropout=0.5 decoder_vision_warp=0.5 --save runs/closed``.
 """

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
-from .config import get_profile, profile_name
+from .config import CHAPTER_EPOCHS, TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
 from .simdata import DatasetConfig, generate, to_dataset, training_frames
 from .utils import cache_dir, config_digest
@@ -75,27 +75,19 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
     return dataset
 
 
-#: Epochs of the chapters' models per profile, where they differ from the profile's own
-#: (``python -m pgae_lite reproduce`` trains the book profile's full 1,200). Three
-#: models are trained while the book builds; 400 epochs each (~5 min on 2 cores) keep the
-#: whole book within half an hour.
-CHAPTER_EPOCHS: dict[str, int] = {"book": 400}
-
-
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
     """A model of one training (a row of Table 1, or PGAE-closed) on the profile's simulated data, cached.
 
     Loaded from the cache if it was trained before.
 
-    ``training`` is one of :data:`pgae_lite.reproduce.TRAININGS` (``"PGAE"``,
+    ``training`` is one of :data:`pgae_lite.config.TRAININGS` (``"PGAE"``,
     ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite, ``"PGAE-closed"`` for
     the closed loop);
     ``train_overrides`` change the profile's training options (e.g. ``epochs=60``).
-    Without ``epochs``, a profile named in :data:`CHAPTER_EPOCHS` trains that many.
+    Without ``epochs``, a profile named in :data:`pgae_lite.config.CHAPTER_EPOCHS` trains that many.
     An interrupted training resumes from its last checkpoint.
     """
-    from .reproduce import TRAININGS, training_profile
     from .train import train
 
     if training not in TRAININGS:
@@ -110,4 +102,4 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path", "CHAPTER_EPOCHS"]
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path"]

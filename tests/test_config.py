@@ -61,3 +61,19 @@ def test_get_profile_copies():
     p = get_profile("smoke", seed=3)
     assert p.train.seed == 3 and PROFILES["smoke"].train.seed == 0
     assert p.model is not PROFILES["smoke"].model and p.data == PROFILES["smoke"].data
+
+
+def test_recipes_live_here():
+    import pgae_lite.reproduce
+    from pgae_lite.config import ROWS, TRAININGS, training_profile
+
+    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-views", "PGAE-closed"]
+    assert {training for training, _ in ROWS.values()} <= set(TRAININGS)
+    assert pgae_lite.reproduce.TRAININGS is TRAININGS and pgae_lite.reproduce.ROWS is ROWS
+    smoke = get_profile("smoke")
+    bert = training_profile(smoke, "PGAE-BERT", pretrained_model="bert-base-uncased")
+    assert bert.model.language_encoder == "pretrained" and bert.model.pretrained_model == "bert-base-uncased"
+    assert (bert.data, bert.cae, bert.chapters) == (smoke.data, smoke.cae, smoke.chapters)   # only the recipe changes
+    closed = training_profile(smoke, "PGAE-closed")
+    assert (closed.train.decoder_vision_dropout, closed.train.decoder_vision_warp) == (0.5, 0.5)
+    assert smoke.train.decoder_vision_dropout == 0.0
