@@ -19,6 +19,7 @@ import json
 import os
 import platform
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -27,11 +28,11 @@ import torch
 from pgae_lite.cae import (
     ChannelSeparatedCAE,
     extract_features,
-    get_cae_config,
     reconstruct,
     train_cae,
 )
-from pgae_lite.train import default_device
+from pgae_lite.config import get_profile
+from pgae_lite.utils import default_device
 
 COLOURS = [(200, 35, 30), (40, 170, 50), (35, 60, 205), (225, 210, 40), (40, 200, 215), (150, 45, 190)]
 
@@ -133,7 +134,7 @@ rows = []
 for threads in args.threads:
     torch.set_num_threads(threads)
     if args.profile:
-        config = get_cae_config(args.profile, **({"iterations": args.iterations} if args.iterations else {}))
+        config = replace(get_profile(args.profile).cae, **({"iterations": args.iterations} if args.iterations else {}))
         data = frames(args.data, args.episodes, args.stride, seed=0)
         test = frames(args.data, max(2, args.episodes // 8), 4, seed=1)
         t0 = time.perf_counter()

@@ -13,7 +13,7 @@ takes N episodes evenly spread over the 216 of the test split. Run it with
 ``OMP_NUM_THREADS=1``: the models are small, a second thread does not help.
 
 The book's PGAE copies from the recorded pictures and drifts in closed loop;
-the training ``PGAE-closed`` (``pgae_lite.reproduce.TRAININGS``) is the one
+the training ``PGAE-closed`` (``pgae_lite.config.TRAININGS``) is the one
 made for it, e.g. ``python benchmarks/explore_recipe.py --sim --epochs 1200
 --set decoder_vision_dropout=0.5 decoder_vision_warp=0.5 --save runs/closed``.
 """
@@ -26,8 +26,8 @@ import time
 import torch
 
 from pgae_lite.closedloop import compare, success_summary
+from pgae_lite.config import get_profile
 from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import load_model
 
 from _report import write_report   # benchmarks/_report.py (the script's folder is on sys.path)
@@ -46,7 +46,7 @@ data = simulated_dataset(args.profile, "cpu", progress=False)
 model, normaliser, ckpt = load_model(args.checkpoint, "cpu", data)   # refuses another cache's features
 
 t0 = time.perf_counter()
-table = compare(model, cae, normaliser, data, limit=args.limit, config=DATASET_PROFILES[args.profile],
+table = compare(model, cae, normaliser, data, limit=args.limit, config=get_profile(args.profile).data,
                 tracking=not args.no_tracking)
 seconds = time.perf_counter() - t0
 summary = success_summary(table)

@@ -25,11 +25,12 @@ def main() -> None:
     os.environ["PGAE_LITE_CACHE"] = args.cache or tempfile.mkdtemp(prefix="pgae-cache-")
 
     from pgae_lite.pipeline import simulated_dataset, trained_cae  # after the cache is set
-    from pgae_lite.simdata import DATASET_PROFILES, generate
+    from pgae_lite.config import get_profile
+    from pgae_lite.simdata import generate
 
     row = {"profile": args.profile, "cache": os.environ["PGAE_LITE_CACHE"], "cpus": os.cpu_count()}
     t0 = time.perf_counter()
-    report = generate(DATASET_PROFILES[args.profile], workers=args.workers)
+    report = generate(get_profile(args.profile).data, workers=args.workers)
     row.update(record_s=round(time.perf_counter() - t0, 1), episodes=report.episodes,
                first_try_pct=round(100 * report.first_try, 2), megabytes=round(report.megabytes, 1))
     print(json.dumps(row), flush=True)

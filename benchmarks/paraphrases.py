@@ -29,9 +29,9 @@ import time
 import torch
 
 from pgae_lite.closedloop import execute_paraphrases, success_summary
+from pgae_lite.config import get_profile
 from pgae_lite.language import LanguageError
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import load_model
 
 from _report import write_report   # benchmarks/_report.py (the script's folder is on sys.path)
@@ -58,7 +58,7 @@ else:
 t0 = time.perf_counter()
 try:
     table = execute_paraphrases(model, cae, normaliser, data, limit=args.limit, closed=not args.open_only,
-                                config=DATASET_PROFILES[args.profile])
+                                config=get_profile(args.profile).data)
 except LanguageError as e:           # a PGAE checkpoint (LSTM language encoder): it cannot read them
     raise SystemExit(f"error: {e}") from None
 seconds = time.perf_counter() - t0

@@ -19,9 +19,10 @@ import sys
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+from pgae_lite.config import ROWS
 from pgae_lite.evaluate import PAPER_TABLE
 from pgae_lite.language import TEST_SIGNALS
-from pgae_lite.reproduce import ROWS, parse_rows
+from pgae_lite.reproduce import parse_rows
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--data", default=os.environ.get("PGAE_ORIGINAL_DATA", "../shared/pgae-original-data"))

@@ -12,7 +12,8 @@ Modules, in the order the book introduces them:
 - ``layers``      peephole LSTM, fused LSTM, Gated Multimodal Unit
 - ``pgae``        encoders, decoders and the PGAE model
 - ``signals``     the five signals: encoder inputs and decoder targets per batch
-- ``config``      training recipes and the profiles smoke / book / paper
+- ``config``      the profiles smoke / book / paper (data, CAE, model, training, chapters) and
+                  Table 1's recipes; the only reader of the profile's environment variable
 - ``train``       loss, training loop, checkpoints
 - ``evaluate``    Table 1: description accuracy and joint nRMSE
 - ``pretrained``  PGAE-BERT's frozen transformer language encoder (chapter 05)
@@ -22,6 +23,7 @@ Modules, in the order the book introduces them:
 - ``playground``  one signal on one episode, and its ipywidgets front end (chapter 08)
 - ``exercises``   check functions: a student's code against the package's, and what is wrong
 - ``viz``         plots and animations for the chapters
+- ``utils``       plumbing: the cache folder, the device, atomic writes, config digests
 
 Command line: ``python -m pgae_lite --help`` (simulate, reproduce).
 """

@@ -9,21 +9,37 @@ prints the table next to the paper's rows and writes ``results.json`` and
 from __future__ import annotations
 
 import argparse
+import ast
 import os
 import sys
+from pathlib import Path
 
-ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")  # pgae_lite.reproduce.ROWS
-PROFILE_NAMES = ("smoke", "book", "paper")  # pgae_lite.config.PROFILES (not imported: --help stays instant)
-PROFILE_ENV = "PGAE_LITE_PROFILE"
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
+
+
+def _from_config(*names: str) -> tuple:
+    """Constants of ``config.py``, read from its source, not imported: importing config loads torch
+    (seconds) and ``--help`` stays instant. tests/test_cli.py checks them against the module."""
+    tree = ast.parse(Path(__file__).with_name("config.py").read_text(encoding="utf-8"))
+    values = {}
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Name):
+            values[node.targets[0].id] = node.value
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            values[node.target.id] = node.value
+    return tuple(ast.literal_eval(values[name]) for name in names)
+
+
+PROFILE_ENV, PROFILE_NAMES, ROWS = _from_config("PROFILE_ENV", "PROFILE_NAMES", "ROWS")
+ROW_NAMES = tuple(ROWS)
 
 
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
     """Record the profile's simulated dataset (or complete it) and print what was done."""
-    from .simdata import DATASET_PROFILES, generate
+    from .config import get_profile
+    from .simdata import generate
 
-    name = profile or os.environ.get(PROFILE_ENV, "book")
-    report = generate(DATASET_PROFILES[name], workers=workers, progress=progress)
+    report = generate(get_profile(profile).data, workers=workers, progress=progress)
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
           f"in {report.seconds:.1f} s, {report.corrupt} damaged files replaced; "
           f"valid on the first try: {100 * report.first_try:.1f}%")
@@ -71,12 +87,19 @@ def main(argv: list[str] | None = None) -> int:
     sim.add_argument("--workers", type=int, default=None, help="parallel processes (default: one per CPU core)")
     sim.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    from .config import profile_name
+
+    try:                      # --profile is checked by argparse; this checks the environment variable too
+        profile = profile_name(args.profile)
+    except ValueError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
     if args.command == "simulate":
-        return simulate(args.profile, args.workers, not args.no_progress)
+        return simulate(profile, args.workers, not args.no_progress)
     if args.command == "reproduce":
         from .data import DataFormatError
         from .reproduce import parse_rows, reproduce
-        from .train import CheckpointMismatchError
+        from .utils import CheckpointMismatchError
 
         try:
             rows = parse_rows(args.rows)
@@ -85,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.seeds < 1:
             parser.error(f"--seeds must be at least 1, got {args.seeds}")
         try:
-            reproduce(args.original_data, args.profile, args.seed, args.out, args.epochs,
+            reproduce(args.original_data, profile, args.seed, args.out, args.epochs,
                       args.device, not args.no_progress, rows, args.seeds, args.pretrained_model)
         except (DataFormatError, CheckpointMismatchError) as e:
             print(f"error: {e}", file=sys.stderr)

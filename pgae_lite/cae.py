@@ -15,9 +15,9 @@ cross-entropy (pixels in [0, 1]):
 Sizes follow the authors' code: conv channels 8-16-32-64, fully connected
 768-384-192-10, Adam 1e-3, batch 200, 10,000 iterations (the ``paper`` profile).
 
-Profiles (``PGAE_LITE_PROFILE``): ``smoke`` (seconds), ``book`` (batch 16 x 1000
-iterations: ~3.7 min on one CPU core, ~2.5 on two), ``paper`` (batch 200 x
-10,000: for a GPU). Features go to the action encoder; see ``extract_features``.
+Profiles (``pgae_lite.config``, each profile's ``cae``): ``smoke`` (seconds), ``book``
+(batch 16 x 1000 iterations: ~3.7 min on one CPU core, ~2.5 on two), ``paper`` (batch
+200 x 10,000: for a GPU). Features go to the action encoder; see ``extract_features``.
 
 Input convention (one for the whole module): a batch of images, ``uint8`` in
 0..255 or float in [0, 1], laid out (B, 120, 160, 3) as a simulator or a PNG
@@ -25,10 +25,9 @@ gives them, or (B, 3, 120, 160) as torch does. Anything else raises ValueError.
 """
 from __future__ import annotations
 
-import os
 import time
 import zlib
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -37,7 +36,7 @@ from torch import nn
 from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
-from .train import CheckpointMismatchError, default_device
+from .utils import CheckpointMismatchError, atomic_path, default_device
 
 HEIGHT, WIDTH = 120, 160
 COLOURS = ("red", "green", "blue")
@@ -66,23 +65,6 @@ class CAEConfig:
     @classmethod
     def from_dict(cls, d: dict) -> CAEConfig:
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in d.items()})
-
-
-CAE_PROFILES: dict[str, CAEConfig] = {
-    "smoke": CAEConfig("smoke", batch_size=8, iterations=20, frame_stride=25),
-    # Deviation from paper: batch 16 x 1000 iterations (~4 minutes on one CPU core) in place of
-    # 200 x 10,000 (~6 hours there). At equal compute, smaller batches (more updates) did better.
-    "book": CAEConfig("book", batch_size=16, iterations=1000, frame_stride=10),
-    "paper": CAEConfig("paper"),
-}
-
-
-def get_cae_config(name: str | None = None, **overrides) -> CAEConfig:
-    """A built-in CAE profile; ``name=None`` reads ``PGAE_LITE_PROFILE`` (default ``book``)."""
-    name = name or os.environ.get("PGAE_LITE_PROFILE", "book")
-    if name not in CAE_PROFILES:
-        raise ValueError(f"unknown CAE profile {name!r}; the profiles are: {', '.join(CAE_PROFILES)}")
-    return replace(CAE_PROFILES[name], **overrides)
 
 
 def _down(cin: int, cout: int, kernel: int, stride: int, pad: int) -> list[nn.Module]:
@@ -238,7 +220,7 @@ def _fingerprint(images: np.ndarray) -> dict:
     return {"shape": list(images.shape), "crc32": zlib.crc32(np.ascontiguousarray(images[pick]).tobytes())}
 
 
-def train_cae(images: np.ndarray, config: CAEConfig | str | None = None, device: torch.device | str | None = None,
+def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str | None = None,
               progress: bool = True, out_path: str | Path | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
     """Train a :class:`ChannelSeparatedCAE` on ``images`` (N, 120, 160, 3) uint8.
 
@@ -251,7 +233,8 @@ def train_cae(images: np.ndarray, config: CAEConfig | str | None = None, device:
     file already holds a model trained with the same config on the same images
     it is loaded instead of training again. Any other file there is refused.
     """
-    config = config if isinstance(config, CAEConfig) else get_cae_config(config)
+    if not isinstance(config, CAEConfig):
+        raise TypeError(f"train_cae wants a CAEConfig, e.g. pgae_lite.config.get_profile().cae; got {config!r}")
     images = np.asarray(images)
     if images.ndim != 4 or images.shape[1:] != (HEIGHT, WIDTH, 3) or images.dtype != np.uint8 or not len(images):
         raise ValueError(f"train_cae wants uint8 images (N, {HEIGHT}, {WIDTH}, 3), N > 0; "
@@ -288,10 +271,9 @@ def train_cae(images: np.ndarray, config: CAEConfig | str | None = None, device:
     if out_path is not None:
         out_path = Path(out_path)
         out_path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = out_path.with_name(out_path.name + ".tmp")
-        torch.save({"model": model.state_dict(), "config": config.to_dict(), "data": data, "history": history,
-                    "seconds": time.perf_counter() - t0}, tmp)
-        os.replace(tmp, out_path)  # atomic: a crash never leaves half a file
+        with atomic_path(out_path) as tmp:   # a crash never leaves half a file
+            torch.save({"model": model.state_dict(), "config": config.to_dict(), "data": data,
+                        "history": history, "seconds": time.perf_counter() - t0}, tmp)
     return model, history
 
 
@@ -333,13 +315,11 @@ def reconstruct(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tensor, b
 
 
 __all__ = [
-    "CAE_PROFILES",
     "CAEConfig",
     "ChannelAutoencoder",
     "ChannelSeparatedCAE",
     "as_input",
     "extract_features",
-    "get_cae_config",
     "load_cae",
     "reconstruct",
     "train_cae",

@@ -55,6 +55,7 @@ import torch
 from tqdm.auto import tqdm
 
 from .cae import ChannelSeparatedCAE, extract_features
+from .config import PROFILES
 from .data import ACTION_SIDES, ARRANGEMENTS, Normaliser, Pattern, PGAEDataset, description_text
 from .evaluate import predict
 from .language import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
@@ -65,7 +66,7 @@ from .signals import EOS, SIGNAL_TOKEN, SignalBatch, make_batch, signal_ids
 from .sim.actions import ActionCheck
 from .sim.record import Simulation
 from .sim.robot import HOME_POSE
-from .simdata import DATASET_PROFILES, DatasetConfig
+from .simdata import DatasetConfig
 from .viz import animate_frames
 
 #: pybullet's default gain of a position motor (Robot.set_targets sets none): each physics
@@ -157,7 +158,7 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
     passed on as ``model.encode(batch, language=language)``; ``description`` is
     then only the rollout's label.
     """
-    config = config or DATASET_PROFILES["book"]
+    config = config or PROFILES["book"].data
     model.eval()
     device = next(model.parameters()).device
     if language is None:
@@ -201,7 +202,7 @@ def open_loop(joints: np.ndarray, pattern: int, variation: int = 0, *, descripti
     E.g. the paper's execute (``predict(..., "execute").joints``) or a recording's own joints.
     Step 0 commands the start pose, as the recordings do; then each step drives towards ``joints[t]``.
     """
-    config = config or DATASET_PROFILES["book"]
+    config = config or PROFILES["book"].data
     sim = _simulation(config)
     frame = _start(sim, config, pattern, variation, render)
     measured, frames, targets = [sim.joints()], [frame], [np.array(HOME_POSE)]

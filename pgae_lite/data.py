@@ -12,7 +12,6 @@ training split only.
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Iterable
@@ -21,6 +20,7 @@ import numpy as np
 import torch
 
 from .language import VOCABULARY, WORD_INDEX, equivalent_descriptions
+from .utils import atomic_write
 
 MAX_STEPS = 100
 JOINT_DIM = 5
@@ -84,10 +84,8 @@ class PGAEDataset:
         """Write every array to one ``.npz`` file, atomically (a temporary file, then a rename)."""
         path = Path(path)
         arrays = {k: getattr(self, k) for k in _ARRAYS}
-        tmp = path.with_name(path.name + ".tmp")
-        with open(tmp, "wb") as f:
+        with atomic_write(path) as f:
             np.savez_compressed(f, source=np.array(self.source), **arrays)
-        os.replace(tmp, path)
 
     @classmethod
     def load(cls, path: str | Path) -> "PGAEDataset":

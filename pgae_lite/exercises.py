@@ -21,7 +21,8 @@ from torch import nn
 from .data import Normaliser
 from .language import COLOURS, SIGNALS, VOCABULARY, word_weights
 from .layers import GatedMultimodalUnit, PeepholeLSTMCell
-from .pgae import PGAE, ModelConfig, count_parameters
+from .config import ModelConfig
+from .pgae import PGAE, count_parameters
 from .signals import SIGNAL_PROBS, make_batch, sample_signals
 from .toydata import toy_dataset
 from .train import pgae_loss
@@ -263,7 +264,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     if not result:
         return result
     result.ok(f"alone: h and z of shape (batch, hidden) = {(B, H)}")
-    model = PGAE(ModelConfig(units=8, layers=2, hidden=H, cell=cell))
+    model = PGAE(ModelConfig(units=8, layers=2, hidden=H, cell=cell, joint_feedback="predicted"))
     sizes = (model.cfg.state_dim, model.language_encoder.output_dim, H)
     gmu = _build(result, factory, *sizes)
     if gmu is None:

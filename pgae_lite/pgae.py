@@ -13,37 +13,16 @@ Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50,
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import torch
 from torch import nn
 
+from .config import ModelConfig
 from .data import JOINT_DIM, VISION_DIM
 from .language import INPUT_DIM, VOCABULARY
 from .layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
 from .signals import SignalBatch
 
 WORDS = len(VOCABULARY)
-
-
-@dataclass
-class ModelConfig:
-    """Architecture of PGAE (defaults: the authors' code)."""
-
-    units: int = 100
-    layers: int = 2
-    hidden: int = 50
-    cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
-    # "predicted" = the paper's: the action decoder reads back its own joints;
-    # "start" = it reads the given start joints at every step (see ActionDecoder).
-    joint_feedback: str = "predicted"
-    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py).
-    language_encoder: str = "lstm"
-    pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
-
-    @property
-    def state_dim(self) -> int:
-        return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
 
 def embedding_init_(rnn: nn.Module) -> None:

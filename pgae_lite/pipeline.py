@@ -14,46 +14,35 @@ earlier chapter (or ``python -m pgae_lite simulate``) already made:
 """
 from __future__ import annotations
 
-import hashlib
-import json
-import os
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .cae import (CAEConfig, ChannelSeparatedCAE, extract_features, get_cae_config, load_cae,
-                  train_cae)
+from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
+from .config import CHAPTER_EPOCHS, TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
-from .simdata import DATASET_PROFILES, DatasetConfig, cache_dir, generate, to_dataset, training_frames
+from .simdata import DatasetConfig, generate, to_dataset, training_frames
+from .utils import cache_dir, config_digest
 
 if TYPE_CHECKING:
     from .train import Trained
 
-PROFILE_ENV = "PGAE_LITE_PROFILE"
 
-
-def profile_name(profile: str | None = None) -> str:
-    """``profile``, else ``$PGAE_LITE_PROFILE``, else ``book``; checked."""
-    name = profile or os.environ.get(PROFILE_ENV, "book")
-    if name not in DATASET_PROFILES:
-        raise ValueError(f"unknown profile {name!r}; the profiles are: {', '.join(DATASET_PROFILES)}")
-    return name
-
-
-def _key(config: CAEConfig) -> str:
-    return hashlib.sha1(json.dumps(config.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
+def _stem(data: DatasetConfig, cae: CAEConfig) -> str:
+    """The cache name of the episodes of ``data`` seen through a CAE trained with ``cae``: two digests."""
+    return f"{data.key()}-{config_digest(cae.to_dict())}"
 
 
 def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
     """Where the CAE trained on ``data`` with ``cae`` is cached."""
-    return cache_dir() / "cae" / f"{data.key()}-{_key(cae)}.pt"
+    return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
 
 
 def trained_cae(profile: str | None = None, device: str | None = None, progress: bool = True,
                 workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
     """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
-    name = profile_name(profile)
-    data, cae = DATASET_PROFILES[name], get_cae_config(name)
+    prof = get_profile(profile)                  # None: the default profile (config.profile_name)
+    data, cae = prof.data, prof.cae
     generate(data, workers=workers, progress=progress)
     path = cae_path(data, cae)
     if path.exists():  # the path is keyed by both configs: no need to read the frames again
@@ -71,26 +60,19 @@ def trained_cae(profile: str | None = None, device: str | None = None, progress:
 def simulated_dataset(profile: str | None = None, device: str | None = None, progress: bool = True,
                       workers: int | None = None) -> PGAEDataset:
     """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
-    name = profile_name(profile)
-    data, cae_config = DATASET_PROFILES[name], get_cae_config(name)
-    path = cache_dir() / "features" / f"{data.key()}-{_key(cae_config)}.npz"
+    prof = get_profile(profile)
+    data, cae_config = prof.data, prof.cae
+    path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
     if path.exists():
         try:
             return PGAEDataset.load(path)
         except DataFormatError as e:
             warnings.warn(f"{e}; computing the features again", stacklevel=2)
-    model, _ = trained_cae(name, device, progress, workers)
+    model, _ = trained_cae(prof.name, device, progress, workers)
     dataset = to_dataset(data, lambda frames: extract_features(model, frames), progress)
     path.parent.mkdir(parents=True, exist_ok=True)
     dataset.save(path)
     return dataset
-
-
-#: Epochs of the chapters' models per profile, where they differ from the profile's own
-#: (``python -m pgae_lite reproduce`` trains the book profile's full 1,200). Three
-#: models are trained while the book builds; 400 epochs each (~5 min on 2 cores) keep the
-#: whole book within half an hour.
-CHAPTER_EPOCHS: dict[str, int] = {"book": 400}
 
 
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
@@ -99,15 +81,13 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
 
     Loaded from the cache if it was trained before.
 
-    ``training`` is one of :data:`pgae_lite.reproduce.TRAININGS` (``"PGAE"``,
+    ``training`` is one of :data:`pgae_lite.config.TRAININGS` (``"PGAE"``,
     ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite, ``"PGAE-closed"`` for
     the closed loop);
     ``train_overrides`` change the profile's training options (e.g. ``epochs=60``).
-    Without ``epochs``, a profile named in :data:`CHAPTER_EPOCHS` trains that many.
+    Without ``epochs``, a profile named in :data:`pgae_lite.config.CHAPTER_EPOCHS` trains that many.
     An interrupted training resumes from its last checkpoint.
     """
-    from .config import get_profile
-    from .reproduce import TRAININGS, training_profile
     from .train import train
 
     if training not in TRAININGS:
@@ -117,9 +97,9 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
         train_overrides.setdefault("epochs", CHAPTER_EPOCHS[name])
     dataset = simulated_dataset(name, device, progress)
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
-    key = hashlib.sha1(json.dumps(prof.to_dict(), sort_keys=True).encode()).hexdigest()[:12]
-    folder = cache_dir() / "pgae" / f"{DATASET_PROFILES[name].key()}-{_key(get_cae_config(name))}-{training}-{key}"
+    stem = _stem(prof.data, prof.cae)
+    folder = cache_dir() / "pgae" / f"{stem}-{training}-{config_digest(prof.to_dict())}"
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path", "profile_name", "CHAPTER_EPOCHS"]
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path"]

@@ -37,13 +37,14 @@ from matplotlib.figure import Figure
 
 from .cae import ChannelSeparatedCAE
 from .closedloop import Rollout, closed_loop, open_loop, pattern_for
+from .config import PROFILES
 from .data import ACTION_SIDES, ARRANGEMENTS, Normaliser, Pattern, PGAEDataset, description_text
 from .language import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
     parse_description, tokenize
 from .pgae import PGAE
 from .pretrained import input_text
 from .signals import LANG_IN, LANG_OUT, make_batch, signal_ids
-from .simdata import DATASET_PROFILES, DatasetConfig
+from .simdata import DatasetConfig
 from .viz import animate_frames, plot_joints
 
 #: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
@@ -77,7 +78,7 @@ def pattern_number(arrangement: int, action: int) -> int:
 def simulator_config(data: PGAEDataset) -> DatasetConfig:
     """The simulated dataset's config (found by the key in ``data.source``), else the book profile's."""
     key = str(data.source).rpartition(":")[2]
-    return next((c for c in DATASET_PROFILES.values() if c.key() == key), DATASET_PROFILES["book"])
+    return next((p.data for p in PROFILES.values() if p.data.key() == key), PROFILES["book"].data)
 
 
 def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[int, int]:

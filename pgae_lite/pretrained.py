@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import os
 import re
 import time
 from dataclasses import dataclass
@@ -32,6 +31,7 @@ from torch import nn
 
 from .language import SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, normalise_signal
 from .signals import EOS, LANG_IN, SIGNAL_TOKEN
+from .utils import atomic_path, cache_dir
 
 # Deviation from paper: the default is all-MiniLM-L6-v2 (22M parameters, 384-d), not
 # BERT Base (110M, 768-d): it installs with pip, with its weights, and runs fast on a laptop CPU.
@@ -244,8 +244,6 @@ class PretrainedLanguageEncoder(nn.Module):
     # ----------------------------------------------------------------------- the disk cache
     def cache_file(self) -> Path:
         """``<cache>/embeddings/<model>-<pooling>-<digest>.pt``: the file of the fixed table."""
-        from .simdata import cache_dir
-
         slug = re.sub(r"[^A-Za-z0-9._-]+", "_", self.name).strip("_")[-60:]
         return cache_dir() / "embeddings" / f"{slug}-{self.pooling}-{self.transformer.digest[:16]}.pt"
 
@@ -276,9 +274,8 @@ class PretrainedLanguageEncoder(nn.Module):
         table = self._run_transformer(self.texts)
         seconds = time.perf_counter() - t0
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-        torch.save({**self._cache_header(), "model": self.name, "embeddings": table, "seconds": seconds}, tmp)
-        os.replace(tmp, path)   # atomic: a crash never leaves half a file
+        with atomic_path(path) as tmp:   # a crash never leaves half a file
+            torch.save({**self._cache_header(), "model": self.name, "embeddings": table, "seconds": seconds}, tmp)
         return table, "computed", seconds
 
     def extra_repr(self) -> str:

@@ -25,48 +25,22 @@ Output folder layout (``out``)::
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import statistics
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from .config import Profile, get_profile
+from .config import ROWS, TRAININGS, Profile, get_profile, training_profile  # TRAININGS: the README names it here
 from .data import PGAEDataset
 from .evaluate import PAPER_TABLE, Predictions, evaluate, format_table
 from .language import TEST_SIGNALS
 from .train import train
+from .utils import atomic_write
 
 
-@dataclass(frozen=True)
-class Training:
-    """What one training changes in the profile's recipe."""
-
-    model: dict = field(default_factory=dict)
-    train: dict = field(default_factory=dict)
-
-
-#: training name -> what it changes in the profile (model and training options)
-TRAININGS: dict[str, Training] = {
-    "PGAE": Training(),
-    "PGAE-BERT": Training(model={"language_encoder": "pretrained"}),
-    # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
-    "PGAE-views": Training(train={"opposite_prob": 0.5}),
-    # No row of Table 1: the model that executes in closed loop (chapter 07, benchmarks/closed_loop.py).
-    # Its action decoder reads the first frame held for half of the samples and frames replayed at a
-    # random speed for all; measured on our data (1,200 epochs, 216 test episodes): see README.
-    "PGAE-closed": Training(train={"decoder_vision_dropout": 0.5, "decoder_vision_warp": 0.5}),
-}
-#: row -> (training, evaluated on the opposite agent's actions?)
-ROWS: dict[str, tuple[str, bool]] = {
-    "PGAE": ("PGAE", False),
-    "PGAE-BERT": ("PGAE-BERT", False),
-    "PGAE-self": ("PGAE-views", False),
-    "PGAE-opposite": ("PGAE-views", True),
-}
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
 CELLS = ("accuracy", "nrmse", "nrmse_padded")
 
@@ -88,15 +62,6 @@ def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
     return out
 
 
-def training_profile(base: Profile, training: str, pretrained_model: str | None = None) -> Profile:
-    """``base`` with one training's changes (and the pretrained model's name, for PGAE-BERT)."""
-    t = TRAININGS[training]
-    model = replace(base.model, **t.model)
-    if training == "PGAE-BERT" and pretrained_model:
-        model = replace(model, pretrained_model=pretrained_model)
-    return Profile(base.name, model, replace(base.train, **t.train))
-
-
 def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
     """``S_ids``, ``S_text``, ``S_joints`` for each test signal S (spaces as ``_``), written atomically."""
     arrays = {}
@@ -105,9 +70,8 @@ def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
         arrays[f"{key}_ids"] = p.ids.astype(str)
         arrays[f"{key}_text"] = np.asarray(p.text, dtype=str)
         arrays[f"{key}_joints"] = p.joints
-    tmp = path.with_name(path.stem + ".tmp.npz")
-    np.savez_compressed(tmp, **arrays)
-    os.replace(tmp, path)
+    with atomic_write(path) as f:
+        np.savez_compressed(f, **arrays)
 
 
 def summarise(per_seed: list[dict[str, dict[str, float]]]) -> tuple[dict, dict]:
@@ -194,5 +158,4 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     return report
 
 
-__all__ = ["reproduce", "run_table1", "parse_rows", "training_profile", "save_predictions", "summarise",
-           "ROWS", "TRAININGS"]
+__all__ = ["reproduce", "run_table1", "parse_rows", "save_predictions", "summarise"]

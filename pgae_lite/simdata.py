@@ -41,17 +41,12 @@ from tqdm.auto import tqdm
 
 from .data import PGAEDataset, Pattern, from_recordings
 from .sim.record import Episode, SimConfig, record_episode
+from .utils import atomic_write, atomic_write_text, cache_dir, config_digest
 
-CACHE_ENV = "PGAE_LITE_CACHE"
 #: Bump when the simulator changes what it records: old caches are then not reused.
 GENERATOR_VERSION = 4
 IMAGE_SHAPE = (120, 160, 3)
 MIN_JOBS_PER_WORKER = 24      # below this many episodes per process, one process is faster
-
-
-def cache_dir() -> Path:
-    """Root of every cache: ``$PGAE_LITE_CACHE``, else ``~/.cache/pgae_lite``."""
-    return Path(os.environ.get(CACHE_ENV) or Path.home() / ".cache" / "pgae_lite").expanduser()
 
 
 @dataclass(frozen=True)
@@ -72,18 +67,7 @@ class DatasetConfig:
 
     def key(self) -> str:
         """Short digest of the config (and the generator version): the cache folder's name."""
-        text = json.dumps({"version": GENERATOR_VERSION, **asdict(self)}, sort_keys=True, default=str)
-        return hashlib.sha1(text.encode()).hexdigest()[:12]
-
-
-#: Two arrangements (0: red+blue, 7: cyan+yellow), every action at both speeds;
-#: 10 of these 24 patterns are test patterns.
-SMOKE_PATTERNS = tuple(sorted(72 * s + 6 * a + i for s in (0, 1) for a in (0, 7) for i in range(6)))
-DATASET_PROFILES: dict[str, DatasetConfig] = {
-    "smoke": DatasetConfig(variations=1, patterns=SMOKE_PATTERNS),
-    "book": DatasetConfig(),
-    "paper": DatasetConfig(),
-}
+        return config_digest({"version": GENERATOR_VERSION, **asdict(self)})
 
 
 class CorruptEpisodeError(RuntimeError):
@@ -129,10 +113,8 @@ def save_episode(path: Path, ep: Episode) -> None:
     digest = _content_digest(arrays)
     for view in ("images", "images_opposite"):
         arrays[view] = _to_differences(arrays[view])
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-    with open(tmp, "wb") as f:
+    with atomic_write(path) as f:
         np.savez_compressed(f, digest=np.array(digest), **arrays)
-    os.replace(tmp, path)
 
 
 def load_episode_file(path: Path) -> Episode:
@@ -194,9 +176,7 @@ def _read_manifest(folder: Path) -> dict[str, dict]:
 
 
 def _write_json(path: Path, obj) -> None:
-    tmp = path.with_name(path.name + f".tmp{os.getpid()}")
-    tmp.write_text(json.dumps(obj, indent=1, sort_keys=True))
-    os.replace(tmp, path)
+    atomic_write_text(path, json.dumps(obj, indent=1, sort_keys=True))
 
 
 def generate(config: DatasetConfig | None = None, workers: int | None = None,
@@ -208,7 +188,7 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
     spawned, so a script that calls this needs the usual ``if __name__ == "__main__":`` guard.
     Safe to interrupt and to call again; damaged files are recorded again.
     """
-    config = config or DATASET_PROFILES["book"]
+    config = config or DatasetConfig()          # the book's (its profiles: pgae_lite.config)
     t0 = time.perf_counter()
     folder = episode_folder(config)
     folder.mkdir(parents=True, exist_ok=True)
@@ -302,6 +282,6 @@ def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarra
                            source=f"simulated:{config.key()}")
 
 
-__all__ = ["DatasetConfig", "DATASET_PROFILES", "SMOKE_PATTERNS", "GenerationReport", "CorruptEpisodeError",
-           "cache_dir", "generate", "load_episode", "iter_episodes", "training_frames", "to_dataset",
+__all__ = ["DatasetConfig", "GenerationReport", "CorruptEpisodeError",
+           "generate", "load_episode", "iter_episodes", "training_frames", "to_dataset",
            "episode_folder", "save_episode", "load_episode_file"]

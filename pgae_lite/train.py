@@ -12,7 +12,6 @@ CPU run round sums differently and drift apart), runs on CUDA when present
 from __future__ import annotations
 
 import math
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,23 +21,15 @@ import torch
 from torch import nn
 from tqdm.auto import tqdm
 
-from .config import Profile, get_profile
+from .config import ModelConfig, Profile, get_profile
 from .data import JOINT_DIM, Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .layers import bfloat16_recurrence
-from .pgae import PGAE, ModelConfig
+from .pgae import PGAE
 from .signals import ACTION_IN, EXECUTE, SignalBatch, make_batch, sample_signals
+from .utils import CheckpointMismatchError, atomic_path, default_device
 
 CHECKPOINT = "checkpoint.pt"
-
-
-class CheckpointMismatchError(ValueError):
-    """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
-
-
-def default_device() -> torch.device:
-    """CUDA when present, else the CPU."""
-    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
 
 
 def pgae_loss(out: dict[str, torch.Tensor], batch: SignalBatch, weights: torch.Tensor,
@@ -287,12 +278,11 @@ def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, g
                     seconds: float) -> None:
     """Write a checkpoint atomically (a crash mid-write never leaves a broken file)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
-                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
-                "history": history, "profile": profile.to_dict(),
-                "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
-    os.replace(tmp, path)
+    with atomic_path(path) as tmp:
+        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
+                    "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
+                    "history": history, "profile": profile.to_dict(),
+                    "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
 
 
 def load_checkpoint(path: str | Path) -> dict:
@@ -337,11 +327,12 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         _check_trained_on(ckpt, fitted, path, dataset.source)
-    model = PGAE(ModelConfig(**ckpt["profile"]["model"]))
+    # Checkpoints older than ModelConfig.joint_feedback were trained with the paper's feedback.
+    model = PGAE(ModelConfig(**{"joint_feedback": "predicted", **ckpt["profile"]["model"]}))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["train", "pgae_loss", "CheckpointMismatchError", "DataMismatchError", "Trained", "load_model",
-           "load_checkpoint", "save_checkpoint", "default_device", "lr_factor"]
+__all__ = ["train", "pgae_loss", "DataMismatchError", "Trained", "load_model", "load_checkpoint",
+           "save_checkpoint", "lr_factor"]

@@ -88,9 +88,10 @@ def _private_cache(tmp_path_factory):
 @pytest.fixture(scope="session")
 def smoke_episodes(_private_cache):
     """The smoke profile's simulated dataset (24 episodes), recorded once per session."""
-    from pgae_lite.simdata import DATASET_PROFILES, generate
+    from pgae_lite.config import get_profile
+    from pgae_lite.simdata import generate
 
-    config = DATASET_PROFILES["smoke"]
+    config = get_profile("smoke").data
     return config, generate(config, progress=False)
 
 

@@ -6,17 +6,16 @@ import pytest
 import torch
 
 from pgae_lite.cae import (
-    CAE_PROFILES,
     CAEConfig,
     ChannelSeparatedCAE,
     as_input,
     extract_features,
-    get_cae_config,
     load_cae,
     reconstruct,
     train_cae,
 )
-from pgae_lite.train import CheckpointMismatchError
+from pgae_lite.config import PROFILES, get_profile
+from pgae_lite.utils import CheckpointMismatchError
 
 TINY = CAEConfig("tiny", batch_size=4, iterations=3, seed=0)
 
@@ -142,15 +141,22 @@ def test_train_cae_wants_uint8_frames(images):
 
 
 def test_profiles(monkeypatch):
-    paper = CAE_PROFILES["paper"]
+    paper = PROFILES["paper"].cae
+    assert paper == CAEConfig()                                   # the authors' recipe
     assert (paper.features, paper.conv, paper.hidden) == (10, (8, 16, 32, 64), (384, 192))
     assert (paper.lr, paper.batch_size, paper.iterations) == (1e-3, 200, 10_000)
+    book = PROFILES["book"].cae
+    assert (book.name, book.batch_size, book.iterations, book.frame_stride) == ("book", 16, 1000, 10)
     monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
-    assert get_cae_config() == CAE_PROFILES["smoke"]
-    assert get_cae_config("book", seed=3).seed == 3
-    with pytest.raises(ValueError, match="unknown CAE profile"):
-        get_cae_config("fast")
+    assert get_profile().cae == PROFILES["smoke"].cae
+    with pytest.raises(ValueError, match="unknown profile 'fast'"):
+        get_profile("fast")
     assert CAEConfig.from_dict(paper.to_dict()) == paper
+
+
+def test_train_cae_wants_a_config(images):
+    with pytest.raises(TypeError, match="CAEConfig"):
+        train_cae(images[:4], "smoke", progress=False)
 
 
 def test_extraction_works_without_batchnorm():

@@ -171,7 +171,32 @@ def test_unknown_row_and_bad_seed_count_are_clear_errors(capsys):
 
 
 def test_cli_profile_names_match_the_package():
-    from pgae_lite.__main__ import PROFILE_NAMES
-    from pgae_lite.config import PROFILES
+    from pgae_lite.__main__ import PROFILE_ENV, PROFILE_NAMES, ROW_NAMES
+    import pgae_lite.config as config
+    from pgae_lite.config import PROFILES, ROWS
 
-    assert tuple(PROFILES) == PROFILE_NAMES
+    assert tuple(PROFILES) == PROFILE_NAMES == config.PROFILE_NAMES
+    assert PROFILE_ENV == config.PROFILE_ENV and ROW_NAMES == tuple(ROWS)
+
+
+def test_help_does_not_import_torch():
+    """--help stays instant: the CLI reads the profile names from config.py without importing it."""
+    code = ("import sys\nfrom pgae_lite.__main__ import main\ntry:\n    main(['reproduce', '--help'])\n"
+            "except SystemExit:\n    pass\nprint('torch' in sys.modules, 'pgae_lite.config' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines()[-1] == "False False"
+
+
+@pytest.mark.parametrize("command", ["simulate", "reproduce"])
+def test_unknown_profile_in_the_environment_is_one_clear_line(command):
+    r = run(command, "--no-progress", env={"PGAE_LITE_PROFILE": "garbage"}, timeout=120)
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.splitlines() == ["error: unknown profile 'garbage' (from the environment variable "
+                                     "PGAE_LITE_PROFILE); the profiles are: smoke, book, paper"]
+
+
+def test_unknown_profile_option_is_refused_by_the_parser(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["simulate", "--profile", "garbage"])
+    assert e.value.code == 2 and "invalid choice: 'garbage'" in capsys.readouterr().err

@@ -7,15 +7,16 @@ import torch
 
 from pgae_lite.closedloop import (animate, closed_loop, compare, execute_batch, open_loop, pattern_for,
                                   success_summary, words_of)
+from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.data import ARRANGEMENTS, Pattern
 from pgae_lite.evaluate import predict
-from pgae_lite.pgae import ActionDecoder, ModelConfig
+from pgae_lite.pgae import ActionDecoder
 from pgae_lite.pipeline import simulated_dataset, trained_cae
 from pgae_lite.sim import Simulation, execute_trajectory
-from pgae_lite.simdata import DATASET_PROFILES, load_episode
+from pgae_lite.simdata import load_episode
 from pgae_lite.train import train
 
-SMOKE = DATASET_PROFILES["smoke"]
+SMOKE = get_profile("smoke").data
 PATTERN = 116   # slide the left cube (cyan) fast: a test pattern of the smoke set, 50 steps
 
 

@@ -10,7 +10,8 @@ import torch
 from pgae_lite.data import Normaliser, Pattern
 from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.language import TEST_SIGNALS, WORD_INDEX
-from pgae_lite.pgae import PGAE, ModelConfig
+from pgae_lite.config import ModelConfig
+from pgae_lite.pgae import PGAE
 
 
 def _predictions(lengths, error, T=100):
@@ -49,7 +50,7 @@ def test_nrmse_perfect_is_zero():
 @pytest.fixture(scope="module")
 def tiny(toy):
     torch.manual_seed(0)
-    model = PGAE(ModelConfig(units=16)).eval()
+    model = PGAE(ModelConfig(units=16, joint_feedback="predicted")).eval()
     return model, Normaliser.fit(toy.split("train"))
 
 
@@ -79,7 +80,7 @@ def test_predict_conventions(toy, tiny):
 
 def test_predict_eos_only_gives_empty_text(toy, tiny):
     _, norm = tiny
-    model = PGAE(ModelConfig(units=16)).eval()
+    model = PGAE(ModelConfig(units=16, joint_feedback="predicted")).eval()
     with torch.no_grad():                                          # force <EOS> at every step
         model.language_decoder.out.weight.zero_()
         model.language_decoder.out.bias.zero_()

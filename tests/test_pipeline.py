@@ -1,7 +1,24 @@
-"""pgae_lite.pipeline.trained_pgae: the chapters' epoch budget, caching by profile."""
+"""pgae_lite.pipeline.trained_pgae: the chapters' epoch budget, caching by profile; unknown profiles."""
 from __future__ import annotations
 
+import pytest
+
 import pgae_lite.pipeline as pipeline
+
+UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
+
+
+@pytest.mark.parametrize("call", [lambda p: pipeline.simulated_dataset(p, progress=False),
+                                  lambda p: pipeline.trained_cae(p, progress=False),
+                                  lambda p: pipeline.trained_pgae("PGAE", p, progress=False)],
+                         ids=["simulated_dataset", "trained_cae", "trained_pgae"])
+def test_an_unknown_profile_is_a_clear_error(call, monkeypatch):
+    with pytest.raises(ValueError) as e:
+        call("garbage")
+    assert str(e.value) == UNKNOWN
+    monkeypatch.setenv("PGAE_LITE_PROFILE", "garbage")
+    with pytest.raises(ValueError, match="'garbage' \\(from the environment variable PGAE_LITE_PROFILE\\)"):
+        call(None)
 
 
 def test_chapter_epochs_apply_unless_epochs_are_given(toy_short, monkeypatch):

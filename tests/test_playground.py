@@ -19,7 +19,8 @@ from pgae_lite.closedloop import instruction_features, paper_execute, pattern_fo
 from pgae_lite.data import ARRANGEMENTS, Normaliser, Pattern
 from pgae_lite.evaluate import predict
 from pgae_lite.language import VOCABULARY, LanguageError
-from pgae_lite.pgae import PGAE, ModelConfig
+from pgae_lite.config import ModelConfig
+from pgae_lite.pgae import PGAE
 from pgae_lite.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
 
@@ -31,7 +32,7 @@ PATTERN = 116
 def tiny(toy):
     """An untrained tiny PGAE and the toy dataset's normaliser."""
     torch.manual_seed(0)
-    return PGAE(ModelConfig(units=16, hidden=8)).eval(), Normaliser.fit(toy.split("train"))
+    return PGAE(ModelConfig(units=16, hidden=8, joint_feedback="predicted")).eval(), Normaliser.fit(toy.split("train"))
 
 
 def _row(data, pattern: int) -> int:
@@ -167,7 +168,7 @@ needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(m) is None for m in
 @needs_bert
 def test_pgae_bert_reads_free_text(toy):
     torch.manual_seed(0)
-    model = PGAE(ModelConfig(units=16, hidden=8, language_encoder="pretrained")).eval()
+    model = PGAE(ModelConfig(units=16, hidden=8, language_encoder="pretrained", joint_feedback="predicted")).eval()
     normaliser = Normaliser.fit(toy.split("train"))
     text = "please shove the azure block away from you, slowly"
     r = play(model, None, normaliser, toy, "execute", 0, 3, text, loop=None)   # 0: red left, blue right; 3: push right
@@ -180,7 +181,7 @@ def test_pgae_bert_reads_free_text(toy):
     with pytest.raises(LanguageError, match="'describe' reads no words"):
         play(model, None, normaliser, toy, "describe", 0, 3, text, loop=None)
     # In the widget, with both models to choose from.
-    lstm = PGAE(ModelConfig(units=16, hidden=8)).eval()
+    lstm = PGAE(ModelConfig(units=16, hidden=8, joint_feedback="predicted")).eval()
     ui = Playground({"PGAE": (lstm, normaliser), "PGAE-BERT": (model, normaliser)}, None, toy)
     ui.arrangement.value, ui.action.value, ui.signal.value, ui.loop.value, ui.text.value = 0, 3, "execute", None, text
     ui.button.click()

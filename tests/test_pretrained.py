@@ -16,7 +16,8 @@ import torch
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import predict
 from pgae_lite.language import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
-from pgae_lite.pgae import PGAE, ModelConfig
+from pgae_lite.config import ModelConfig
+from pgae_lite.pgae import PGAE
 from pgae_lite.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
                                   input_text, token_codes, tokens_to_text)
 from pgae_lite.signals import make_batch, signal_ids
@@ -70,7 +71,7 @@ def test_frozen_and_outside_the_state_dict(encoder):
     assert list(encoder.parameters()) == [] and encoder.state_dict() == {}
     tf = encoder.transformer.model
     assert not tf.training and not any(p.requires_grad for p in tf.parameters())
-    model = PGAE(ModelConfig(units=16, language_encoder="pretrained"))
+    model = PGAE(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
     assert model.language_encoder.transformer is encoder.transformer      # one copy per process
     assert not any(k.startswith("language_encoder") for k in model.state_dict())
     assert sum(v.numel() for v in model.state_dict().values()) < 200_000  # MiniLM alone: 22.7M
@@ -167,7 +168,7 @@ def test_cache_is_reused_and_a_damaged_file_recomputed(encoder, tmp_path):
 
 # --------------------------------------------------------------------------- in PGAE
 def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
-    model = PGAE(ModelConfig(units=16, language_encoder="pretrained"))
+    model = PGAE(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
     index = torch.tensor([72, 0, 100, 1])
     batch = make_batch(toy_tensors, index, signal_ids(["describe", "execute", "repeat language", "repeat both"]),
                        torch.tensor([0, 1, 2, 3]))

@@ -4,9 +4,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from pgae_lite.config import SMOKE_PATTERNS
 from pgae_lite.data import PGAEDataset, Pattern
 from pgae_lite.simdata import (CorruptEpisodeError, DatasetConfig, episode_folder, generate, load_episode,
-                               load_episode_file, SMOKE_PATTERNS)
+                               load_episode_file)
 
 
 def test_smoke_dataset_is_recorded_with_the_papers_split(smoke_episodes):

@@ -9,10 +9,9 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.config import PROFILE_ENV, PROFILES, Profile, TrainConfig, get_profile
+from pgae_lite.config import PROFILE_ENV, PROFILES, ModelConfig, Profile, TrainConfig, get_profile
 from pgae_lite.data import Normaliser
 from pgae_lite.evaluate import predict
-from pgae_lite.pgae import ModelConfig
 from pgae_lite.train import CHECKPOINT, DataMismatchError, load_checkpoint, load_model, lr_factor, pgae_loss, train
 
 
@@ -20,7 +19,7 @@ def tiny_profile(units: int = 16, **train) -> Profile:
     """12 training samples, batches of 4, a few epochs: a second or two of training."""
     cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1,
                   action_weight=1.0, input_noise=0.05, joint_input_noise=None)
-    return Profile("tiny", ModelConfig(units=units), replace(cfg, **train))
+    return Profile("tiny", ModelConfig(units=units, joint_feedback="predicted"), replace(cfg, **train))
 
 
 def _weights(model):

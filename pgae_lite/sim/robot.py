@@ -39,6 +39,8 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
+from ..utils import atomic_write_text
+
 #: The 5 recorded joints of the left arm, from shoulder to wrist.
 JOINT_NAMES: tuple[str, ...] = ("l_shoulder_z", "l_shoulder_y", "l_arm_x", "l_elbow_y", "l_wrist_y")
 #: Joint limits (lower, upper) in radians, in the order of JOINT_NAMES.
@@ -161,10 +163,7 @@ def urdf_path() -> str:
     text = nico_urdf()
     path = os.path.join(tempfile.gettempdir(), f"nico_lite_{hashlib.sha1(text.encode()).hexdigest()[:12]}.urdf")
     if not os.path.exists(path):
-        fd, tmp = tempfile.mkstemp(suffix=".urdf", dir=os.path.dirname(path))
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.replace(tmp, path)                  # atomic: parallel workers never see half a file
+        atomic_write_text(path, text)          # parallel workers never see half a file
     return path
 
 

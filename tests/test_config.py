@@ -1,0 +1,79 @@
+"""pgae_lite.config: the one home of the profiles, and the only reader of PGAE_LITE_PROFILE."""
+from __future__ import annotations
+
+import pytest
+
+from pgae_lite.cae import CAEConfig
+from pgae_lite.config import (PROFILE_ENV, PROFILE_NAMES, PROFILES, SMOKE_PATTERNS, ChapterSettings, Profile,
+                              get_profile, profile_name)
+from pgae_lite.simdata import DatasetConfig
+
+UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
+
+
+def test_profile_name(monkeypatch):
+    monkeypatch.delenv(PROFILE_ENV, raising=False)
+    assert profile_name() == "book"
+    monkeypatch.setenv(PROFILE_ENV, "smoke")
+    assert profile_name() == "smoke" and profile_name("paper") == "paper"
+    assert tuple(PROFILES) == PROFILE_NAMES == ("smoke", "book", "paper")
+
+
+def test_an_unknown_profile_is_a_clear_error(monkeypatch):
+    monkeypatch.delenv(PROFILE_ENV, raising=False)
+    for call in (profile_name, get_profile):
+        with pytest.raises(ValueError) as e:
+            call("garbage")
+        assert str(e.value) == UNKNOWN
+    monkeypatch.setenv(PROFILE_ENV, "garbage")               # from the environment: it says so
+    for call in (profile_name, get_profile):
+        with pytest.raises(ValueError) as e:
+            call()
+        assert str(e.value) == (f"unknown profile 'garbage' (from the environment variable {PROFILE_ENV}); "
+                                "the profiles are: smoke, book, paper")
+
+
+def test_a_profile_holds_the_whole_run():
+    smoke, book, paper = (get_profile(n) for n in PROFILE_NAMES)
+    assert smoke.data == DatasetConfig(variations=1, patterns=SMOKE_PATTERNS) and len(SMOKE_PATTERNS) == 24
+    assert book.data == paper.data == DatasetConfig()
+    assert smoke.cae == CAEConfig("smoke", batch_size=8, iterations=20, frame_stride=25)
+    assert book.cae == CAEConfig("book", batch_size=16, iterations=1000, frame_stride=10)
+    assert paper.cae == CAEConfig()
+    assert smoke.chapters == ChapterSettings(runs_per_action=1, training_epochs=2, test_episodes=2,
+                                             paraphrase_episodes=2, every=10)
+    assert book.chapters == ChapterSettings(runs_per_action=4, training_epochs=60, test_episodes=36,
+                                            paraphrase_episodes=12, every=4)
+    assert paper.chapters == ChapterSettings(runs_per_action=6, training_epochs=None, test_episodes=36,
+                                             paraphrase_episodes=12, every=4)
+    default = Profile("book")                                 # the defaults are the book profile
+    assert (default.model, default.train, default.data, default.cae, default.chapters) == (
+        book.model, book.train, book.data, book.cae, book.chapters)
+
+
+def test_to_dict_holds_only_the_models_recipe():
+    """It is hashed into the cache keys of trained models and saved in checkpoints: nothing else goes in."""
+    for name in PROFILE_NAMES:
+        assert set(get_profile(name).to_dict()) == {"name", "model", "train"}
+
+
+def test_get_profile_copies():
+    p = get_profile("smoke", seed=3)
+    assert p.train.seed == 3 and PROFILES["smoke"].train.seed == 0
+    assert p.model is not PROFILES["smoke"].model and p.data == PROFILES["smoke"].data
+
+
+def test_recipes_live_here():
+    import pgae_lite.reproduce
+    from pgae_lite.config import ROWS, TRAININGS, training_profile
+
+    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-views", "PGAE-closed"]
+    assert {training for training, _ in ROWS.values()} <= set(TRAININGS)
+    assert pgae_lite.reproduce.TRAININGS is TRAININGS and pgae_lite.reproduce.ROWS is ROWS
+    smoke = get_profile("smoke")
+    bert = training_profile(smoke, "PGAE-BERT", pretrained_model="bert-base-uncased")
+    assert bert.model.language_encoder == "pretrained" and bert.model.pretrained_model == "bert-base-uncased"
+    assert (bert.data, bert.cae, bert.chapters) == (smoke.data, smoke.cae, smoke.chapters)   # only the recipe changes
+    closed = training_profile(smoke, "PGAE-closed")
+    assert (closed.train.decoder_vision_dropout, closed.train.decoder_vision_warp) == (0.5, 0.5)
+    assert smoke.train.decoder_vision_dropout == 0.0

@@ -1,0 +1,115 @@
+"""The package's import graph: nothing imports in a circle, and one module owns the profiles.
+
+Every module of ``pgae_lite`` is parsed (not imported) and every import of another
+module of the package is an edge, whether it sits at the top of the file, inside a
+function or under ``if TYPE_CHECKING``: a function-level import that closes a
+circle only moves the failure to the first call.
+"""
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent.parent / "pgae_lite"
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def imported_modules(name: str) -> set[str]:
+    """The package's modules that module ``name`` imports, anywhere in its code."""
+    path = MODULES[name]
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            targets = [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                anchor = package.split(".")[:len(package.split(".")) - node.level + 1]
+                base = ".".join(anchor + ([base] if base else []))
+            # "from . import x": x may be a module of the package
+            targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in MODULES else base for a in node.names]
+        else:
+            continue
+        for target in targets:
+            while target and target not in MODULES:          # "pgae_lite.sim.record.Episode" -> the module
+                target = target.rpartition(".")[0]
+            if not target or target == name:
+                continue
+            found.add(target)
+            # Importing a.b.c runs the __init__ of every package on the way, unless we are inside it.
+            parts = target.split(".")
+            for i in range(1, len(parts)):
+                parent = ".".join(parts[:i])
+                if parent in MODULES and not (name + ".").startswith(parent + "."):
+                    found.add(parent)
+    return found
+
+
+GRAPH = {name: imported_modules(name) for name in MODULES}
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """A list of modules that import each other in a circle (first == last), or None."""
+    state, stack = {}, []
+
+    def visit(node):
+        state[node] = "open"
+        stack.append(node)
+        for nxt in sorted(graph[node]):
+            if state.get(nxt) == "open":
+                return stack[stack.index(nxt):] + [nxt]
+            if nxt not in state and (cycle := visit(nxt)):
+                return cycle
+        state[node] = "done"
+        stack.pop()
+        return None
+
+    for node in sorted(graph):
+        if node not in state and (cycle := visit(node)):
+            return cycle
+    return None
+
+
+def reachable(name: str) -> set[str]:
+    seen, todo = set(), [name]
+    while todo:
+        for nxt in GRAPH[todo.pop()] - seen:
+            seen.add(nxt)
+            todo.append(nxt)
+    return seen
+
+
+def test_the_graph_is_read():
+    assert GRAPH["pgae_lite.train"] >= {"pgae_lite.config", "pgae_lite.pgae", "pgae_lite.utils"}
+    assert "pgae_lite.train" in GRAPH["pgae_lite.pipeline"]           # a function-level import counts
+    assert "pgae_lite.language" in GRAPH["pgae_lite.sim.actions"]      # from ..language
+    assert "pgae_lite.sim" in GRAPH["pgae_lite.closedloop"]            # a subpackage runs its __init__
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+
+
+def test_no_import_cycles():
+    cycle = find_cycle(GRAPH)
+    assert cycle is None, "modules import each other in a circle: " + " -> ".join(cycle)
+
+
+def test_config_imports_nothing_that_imports_it():
+    below = reachable("pgae_lite.config")
+    assert not below & {"pgae_lite.config", "pgae_lite.train", "pgae_lite.pipeline", "pgae_lite.reproduce",
+                        "pgae_lite.pgae"}, sorted(below)
+    assert not reachable("pgae_lite.utils")                            # plumbing: imports nothing of ours
+    assert "pgae_lite.train" not in reachable("pgae_lite.cae")
+    assert "pgae_lite.reproduce" not in reachable("pgae_lite.pipeline")
+
+
+def test_only_config_reads_the_profile_variable():
+    files = sorted(PACKAGE.glob("*.py")) + sorted(PACKAGE.glob("sim/*.py"))
+    readers = [p.relative_to(PACKAGE).as_posix() for p in files if "PGAE_LITE_PROFILE" in p.read_text(encoding="utf-8")]
+    assert readers == ["config.py"], f"only config.py may name PGAE_LITE_PROFILE; found in {readers}"
