@@ -8,9 +8,10 @@ output folder under benchmarks/out/ (so an interrupted benchmark resumes, and
 a finished seed is read, not run again). ``--jobs 2 --threads 1`` runs two
 seeds at once, one core each: more throughput on a 2-core machine, but each
 run's wall time is then not that of a run alone; measure that with
-``--jobs 1 --threads 2``.
+``--jobs 1 --threads 2``. Writes results/table1-original.json (or
+table1-sim.json): every seed's cells, their median, mean and std, the paper's,
+and whether each median is at or better than the paper's.
 """
-import argparse
 import json
 import os
 import statistics
@@ -24,24 +25,24 @@ from pgae_lite.evaluate import PAPER_TABLE
 from pgae_lite.language import TEST_SIGNALS
 from pgae_lite.reproduce import parse_rows
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-ap.add_argument("--data", default=os.environ.get("PGAE_ORIGINAL_DATA", "../shared/pgae-original-data"))
-ap.add_argument("--sim", action="store_true", help="our simulated data instead of the authors'")
-ap.add_argument("--rows", default="PGAE")
-ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-ap.add_argument("--profile", default="book")
-ap.add_argument("--jobs", type=int, default=1)
-ap.add_argument("--threads", type=int, default=2)
-ap.add_argument("--out", default="benchmarks/out")
-args = ap.parse_args()
+from harness import Benchmark
+
+source = "sim" if "--sim" in sys.argv else "original"   # names the result file
+bench = Benchmark(f"table1-{source}", __doc__, seeds=[0, 1, 2])
+bench.parser.add_argument("--data", default=os.environ.get("PGAE_ORIGINAL_DATA", "../shared/pgae-original-data"))
+bench.parser.add_argument("--sim", action="store_true", help="our simulated data instead of the authors'")
+bench.parser.add_argument("--rows", default="PGAE")
+bench.parser.add_argument("--jobs", type=int, default=1)
+bench.parser.add_argument("--runs", default="benchmarks/out", help="the runs' output folders (resumable)")
+args = bench.parse()
+threads = args.threads or 2
 rows = parse_rows(args.rows)
-source = "sim" if args.sim else "original"
 
 
 def run(seed: int) -> dict:
-    out = Path(args.out) / f"table1-{source}-{args.profile}-{'+'.join(rows)}-seed{seed}"
+    out = Path(args.runs) / f"table1-{source}-{args.profile}-{'+'.join(rows)}-seed{seed}"
     if not (out / "results.json").exists():
-        env = dict(os.environ, OMP_NUM_THREADS=str(args.threads))
+        env = dict(os.environ, OMP_NUM_THREADS=str(threads))
         data = [] if args.sim else ["--original-data", args.data]
         subprocess.run([sys.executable, "-m", "pgae_lite", "reproduce", *data, "--rows", ",".join(rows),
                         "--profile", args.profile, "--seed", str(seed), "--out", str(out), "--no-progress",
@@ -81,7 +82,4 @@ for row in rows:
                                                   for s in TEST_SIGNALS))
     lines.append("median at or better than the paper: " + json.dumps(verdict))
 print("\n".join(lines))
-Path(args.out).mkdir(parents=True, exist_ok=True)
-(Path(args.out) / f"table1-{source}-{args.profile}-{'+'.join(rows)}.json").write_text(json.dumps(
-    {"rows": summary, "jobs": args.jobs, "threads": args.threads, "profile": args.profile, "data": source},
-    indent=2))
+bench.write({"data": source, "rows": summary, "jobs": args.jobs, "threads_per_run": threads})

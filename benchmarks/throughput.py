@@ -1,12 +1,11 @@
 """Training throughput of PGAE on the authors' data: samples per second and seconds per epoch.
 
     python benchmarks/throughput.py [--data PATH] [--batches 6 64] [--cells lstm peephole]
-                                    [--feedback teacher own start]
+                                    [--feedback own start]
 
 For each cell and batch size it times full training steps (signals drawn per
 sample, forward, loss, backward, Adam) for each way the action decoder reads
-joints: ``teacher`` (the recorded ones), ``own`` (its own predictions, the
-paper's) and ``start`` (the start joints at every step, joint_feedback="start"),
+joints: ``own`` (its own predictions, the paper's) and ``start`` (the start joints at every step, joint_feedback="start"),
 and extrapolates to one epoch of the 648 training samples. Run it on an
 otherwise idle machine.
 """
@@ -27,7 +26,7 @@ ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDe
 ap.add_argument("--data", default="../shared/pgae-original-data")
 ap.add_argument("--batches", type=int, nargs="+", default=[6, 64])
 ap.add_argument("--cells", nargs="+", default=["lstm", "peephole"])
-ap.add_argument("--feedback", nargs="+", default=["teacher", "own", "start"], choices=["teacher", "own", "start"])
+ap.add_argument("--feedback", nargs="+", default=["own", "start"], choices=["own", "start"])
 ap.add_argument("--threads", type=int, default=None, help="torch threads (default: torch's choice)")
 ap.add_argument("--seconds", type=float, default=10.0, help="time budget per measurement")
 args = ap.parse_args()
@@ -42,7 +41,6 @@ for cell in args.cells:
     for bs in args.batches:
         for feedback in args.feedback:
             torch.manual_seed(0)
-            teacher = feedback == "teacher"
             model = PGAE(ModelConfig(cell=cell, joint_feedback="start" if feedback == "start" else "predicted"))
             opt = torch.optim.Adam(model.parameters(), 1e-3)
             gen = torch.Generator().manual_seed(0)
@@ -50,7 +48,7 @@ for cell in args.cells:
             def step():
                 index = torch.randint(len(data), (bs,), generator=gen)
                 batch = make_batch(tensors, index, sample_signals(bs, gen), torch.randint(8, (bs,), generator=gen))
-                out = model(batch, teacher_language=True, teacher_joints=teacher)
+                out = model(batch, teacher_language=True)
                 loss = pgae_loss(out, batch, weights)[0]
                 opt.zero_grad()
                 loss.backward()

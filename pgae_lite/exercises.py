@@ -273,7 +273,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     toy = toy_dataset(1, seed, patterns=[0, 7, 80, 101, 140])  # five recordings, 100 or 50 steps
     batch = make_batch(Normaliser.fit(toy).tensors(toy), torch.arange(5), signal=torch.arange(5),  # one each
                        alternative=torch.arange(5) % 8)
-    out = _call(result, "PGAE with it", lambda: model(batch, teacher_language=True, teacher_joints=True))
+    out = _call(result, "PGAE with it", lambda: model(batch, teacher_language=True))
     if out is None:
         return result
     loss = pgae_loss(out, batch, word_weights())[0]

@@ -11,9 +11,6 @@ step. A sample's final state is the state after its last valid step.
 """
 from __future__ import annotations
 
-import contextlib
-import contextvars
-
 import torch
 from torch import nn
 
@@ -108,19 +105,6 @@ class PeepholeLSTM(nn.Module):
         return inp, (torch.stack(hs), torch.stack(cs))
 
 
-_BFLOAT16 = contextvars.ContextVar("bfloat16_recurrence", default=False)
-
-
-@contextlib.contextmanager
-def bfloat16_recurrence(enabled: bool = True):
-    """Inside, :class:`FusedLSTM` runs on the CPU with bfloat16 matmuls (everything else stays float32)."""
-    token = _BFLOAT16.set(enabled)
-    try:
-        yield
-    finally:
-        _BFLOAT16.reset(token)
-
-
 class FusedLSTM(nn.Module):
     """``torch.nn.LSTM`` (no peepholes) behind the same interface as :class:`PeepholeLSTM`.
 
@@ -145,20 +129,8 @@ class FusedLSTM(nn.Module):
 
     def forward(self, x: torch.Tensor, lengths: torch.Tensor | None = None,
                 state: State | None = None) -> tuple[torch.Tensor, State]:
-        weights, low = self.lstm._flat_weights, _BFLOAT16.get() and x.device.type == "cpu"
-        if low:  # bfloat16 copies for the kernel; the parameters (and their gradients) stay float32
-            weights = [w.to(torch.bfloat16) for w in weights]
-
-        def run(x: torch.Tensor, s: State | None) -> tuple[torch.Tensor, State]:   # nn.LSTM's own kernel
-            if s is None:
-                s = (x.new_zeros(self.num_layers, x.shape[0], self.hidden_size),) * 2
-            if low:
-                x, s = x.to(torch.bfloat16), (s[0].to(torch.bfloat16), s[1].to(torch.bfloat16))
-            y, h, c = torch._VF.lstm(x, s, weights, True, self.num_layers, 0.0, self.training, False, True)
-            return (y.float(), (h.float(), c.float())) if low else (y, (h, c))
-
         if lengths is None:
-            return run(x, state)
+            return self.lstm(x, state)
         # Samples of equal length run together, each group for exactly its length.
         # (pack_padded_sequence gives the same result but is ~3x slower on a CPU.)
         batch, steps, _ = x.shape
@@ -169,7 +141,7 @@ class FusedLSTM(nn.Module):
         for n in lengths.unique().tolist():
             idx = (lengths == n).nonzero().squeeze(1)
             s = None if state is None else (state[0][:, idx], state[1][:, idx])
-            y, (h_n, c_n) = run(x[idx, :n], s)                  # y (group, n, H)
+            y, (h_n, c_n) = self.lstm(x[idx, :n], s)            # y (group, n, H)
             out = out.index_copy(0, idx, nn.functional.pad(y, (0, 0, 0, steps - n)))
             h, c = h.index_copy(1, idx, h_n), c.index_copy(1, idx, c_n)
         return out, (h, c)

@@ -119,8 +119,8 @@ class ActionDecoder(nn.Module):
     """Generates joints step by step: input [v_t; ĵ_t], output ĵ_{t+1} = tanh(W y_t + b).
 
     The visual features v_t are the recorded ones at every step (teacher-forced,
-    as in the paper); the joints are the decoder's own previous predictions,
-    or the recorded ones when ``teacher_joints`` is given (faster training).
+    as in the paper); the joints are the decoder's own previous predictions (the
+    paper's) or the start joints (``joint_feedback="start"``).
 
     One step at a time, e.g. to drive a robot that renders v_t as it moves
     (:mod:`pgae_lite.closedloop`)::
@@ -156,21 +156,18 @@ class ActionDecoder(nn.Module):
         return torch.tanh(self.out(y)), state
 
     def forward(self, h: torch.Tensor, vision: torch.Tensor, start: torch.Tensor,
-                teacher_joints: torch.Tensor | None = None, steps: torch.Tensor | None = None) -> torch.Tensor:
+                steps: torch.Tensor | None = None) -> torch.Tensor:
         """vision (B, S, 30), start (B, 5) -> joints of steps 1..S (B, S, 5).
 
         ``steps`` (B,), if given, is how many steps each sample needs: a free-running
         decoder then stops computing a sample after its last step (outputs 0 there).
         """
         state = self.begin(h)
-        if self.feedback == "start" or teacher_joints is not None:
-            if self.feedback == "start":
-                # Deviation from paper: the decoder reads the start joints at every step instead of
-                # its own predictions, so its small errors cannot feed back and grow, and training
-                # and test run the same single fused pass (no teacher forcing needed).
-                prev = start[:, None].expand(-1, vision.shape[1], -1)         # (B, S, 5)
-            else:                                                             # inputs ĵ_t := recorded j_t
-                prev = torch.cat([start[:, None], teacher_joints[:, :-1]], 1)  # (B, S, 5)
+        if self.feedback == "start":
+            # Deviation from paper: the decoder reads the start joints at every step instead of
+            # its own predictions, so its small errors cannot feed back and grow, and training
+            # and test run the same single fused pass over all steps.
+            prev = start[:, None].expand(-1, vision.shape[1], -1)             # (B, S, 5)
             y, _ = self.rnn(torch.cat([vision, prev], 2), steps, state)      # each sample for its own steps
             joints = torch.tanh(self.out(y))                                  # (B, S, 5)
             if steps is not None:                                             # 0 past a sample's last step
@@ -225,27 +222,17 @@ class PGAE(nn.Module):
         f_act = self.action_encoder(batch.action_input, batch.action_lengths)
         return self.gmu(f_act, f_lang)
 
-    def forward(self, batch: SignalBatch, teacher_language: bool = False,
-                teacher_joints: bool = False, feedback: str = "greedy",
-                joint_noise: float = 0.0, language: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
+    def forward(self, batch: SignalBatch, teacher_language: bool = False, feedback: str = "greedy",
+                language: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
         """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden).
 
-        With ``teacher_joints`` the action decoder reads the recorded joints, plus
-        Gaussian noise of standard deviation ``joint_noise`` (training only).
+        ``teacher_language``: the language decoder reads the target words (training).
         ``language`` (B, D): precomputed language features in place of the encoder's (see :meth:`encode`).
         """
         h, z = self.encode(batch, language)
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
-        teacher = None
-        if teacher_joints:
-            teacher = batch.joint_target
-            if joint_noise:
-                # Deviation from paper: noisy recorded joints teach the decoder to recover
-                # from its own small errors (it reads its own predictions at test time).
-                teacher = teacher + joint_noise * torch.randn_like(teacher)
-        joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, teacher,
-                                     steps=batch.joint_mask.sum(1))
+        joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, steps=batch.joint_mask.sum(1))
         return {"logits": logits, "joints": joints, "h": h, "gate": z}
 
 

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
-from .config import CHAPTER_EPOCHS, TRAININGS, get_profile, profile_name, training_profile
+from .config import TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
 from .simdata import DatasetConfig, generate, to_dataset, training_frames
 from .utils import cache_dir, config_digest
@@ -77,15 +77,14 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
 
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
-    """A model of one training (a row of Table 1, or PGAE-closed) on the profile's simulated data, cached.
+    """A model of one training (for a row of Table 1) on the profile's simulated data, cached.
 
     Loaded from the cache if it was trained before.
 
     ``training`` is one of :data:`pgae_lite.config.TRAININGS` (``"PGAE"``,
-    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite, ``"PGAE-closed"`` for
-    the closed loop);
-    ``train_overrides`` change the profile's training options (e.g. ``epochs=60``).
-    Without ``epochs``, a profile named in :data:`pgae_lite.config.CHAPTER_EPOCHS` trains that many.
+    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
+    ``train_overrides`` change the profile's training options (e.g. ``seed=1``); without
+    them it is the profile's recipe, the model every chapter and ``reproduce`` train.
     An interrupted training resumes from its last checkpoint.
     """
     from .train import train
@@ -93,8 +92,6 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     if training not in TRAININGS:
         raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
     name = profile_name(profile)
-    if name in CHAPTER_EPOCHS:
-        train_overrides.setdefault("epochs", CHAPTER_EPOCHS[name])
     dataset = simulated_dataset(name, device, progress)
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
     stem = _stem(prof.data, prof.cae)

@@ -12,8 +12,6 @@ Paper, Sec. 4 and Table 1. Four rows come from three trainings::
 ``execute`` and ``repeat language`` show no action to the encoder beyond the
 first step, so PGAE-opposite shares those two cells with PGAE-self (as in the
 paper). With several seeds every cell is reported as mean ± standard deviation.
-A fourth training, ``PGAE-closed``, is no row of the table: it is the model
-made to drive the robot with its own camera (the closed loop, chapter 07).
 
 Output folder layout (``out``)::
 
@@ -127,7 +125,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
 
     ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
     our simulated data (simulator -> CAE -> PGAE, each step cached). ``rows``: see
-    :data:`ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
+    :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
     per row are trained, with seeds ``seed, seed + 1, ...``.
     """
     from .data import load_original

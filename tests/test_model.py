@@ -49,32 +49,29 @@ def test_fused_parameter_count():
 
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
-def test_teacher_forced_and_free_running_agree_at_step_0(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
+def test_start_and_predicted_joint_feedback_agree_at_step_0(toy_tensors, cell):
+    """Both read the start joints at step 0; later only "predicted" reads its own predictions."""
+    torch.manual_seed(0)
+    predicted = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
+    start = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="start")).eval()
+    start.load_state_dict(predicted.state_dict())
     b = _batch(toy_tensors)
     with torch.no_grad():
-        free = model(b)
-        forced = model(b, teacher_language=True, teacher_joints=True)
-    torch.testing.assert_close(forced["logits"][:, 0], free["logits"][:, 0])
-    torch.testing.assert_close(forced["joints"][:, 0], free["joints"][:, 0])
-    torch.testing.assert_close(forced["h"], free["h"])
-    # Later steps differ (an untrained model does not predict the recorded joints).
-    assert not torch.allclose(forced["joints"][:, 1:], free["joints"][:, 1:])
+        free, fused = predicted(b), start(b, teacher_language=True)
+    torch.testing.assert_close(fused["logits"][:, 0], free["logits"][:, 0])
+    torch.testing.assert_close(fused["joints"][:, 0], free["joints"][:, 0])
+    torch.testing.assert_close(fused["h"], free["h"])
+    assert not torch.allclose(fused["joints"][:, 1:], free["joints"][:, 1:])
 
 
-@pytest.mark.parametrize("cell", ["lstm", "peephole"])
-def test_free_running_action_decoder_uses_its_own_predictions(toy_tensors, cell):
-    model = PGAE(ModelConfig(units=16, cell=cell, joint_feedback="predicted")).eval()
+@pytest.mark.parametrize("feedback", ["start", "predicted"])
+def test_action_decoder_never_reads_the_target_joints(toy_tensors, feedback):
+    model = PGAE(ModelConfig(units=16, joint_feedback=feedback)).eval()
     b = _batch(toy_tensors)
     changed = _batch(toy_tensors)
     changed.joint_target = changed.joint_target + 0.5
     with torch.no_grad():
-        free, free_changed = model(b)["joints"], model(changed)["joints"]
-        forced, forced_changed = (model(b, teacher_joints=True)["joints"],
-                                  model(changed, teacher_joints=True)["joints"])
-    assert torch.equal(free, free_changed)
-    assert not torch.allclose(forced[:, 1:], forced_changed[:, 1:])
-    torch.testing.assert_close(forced[:, 0], forced_changed[:, 0])        # step 0 sees only the start joints
+        assert torch.equal(model(b)["joints"], model(changed)["joints"])
 
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
@@ -94,7 +91,7 @@ def test_language_decoder_modes(toy_tensors, cell):
 
 def test_gradients_reach_every_module(toy_tensors):
     model = PGAE(ModelConfig(units=16, joint_feedback="predicted"))
-    out = model(_batch(toy_tensors), teacher_language=True, teacher_joints=True)
+    out = model(_batch(toy_tensors), teacher_language=True)
     (out["logits"].sum() + out["joints"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
     assert not missing
@@ -114,16 +111,3 @@ def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, ce
     mask = b.joint_mask[..., None].expand_as(full)
     torch.testing.assert_close(short[mask], full[mask])
     assert (short[~mask] == 0).all()
-
-
-def test_joint_noise_only_changes_teacher_forced_inputs(toy_tensors):
-    torch.manual_seed(0)
-    model = PGAE(ModelConfig(units=16, joint_feedback="predicted")).eval()
-    b = _batch(toy_tensors)
-    with torch.no_grad():
-        clean = model(b, teacher_joints=True)["joints"]
-        noisy = model(b, teacher_joints=True, joint_noise=0.1)["joints"]
-        free, free_noise = model(b)["joints"], model(b, joint_noise=0.1)["joints"]
-    torch.testing.assert_close(noisy[:, 0], clean[:, 0])           # step 0 reads the start joints
-    assert not torch.allclose(noisy[:, 1:], clean[:, 1:])
-    assert torch.equal(free, free_noise)                            # free-running: no teacher, no noise

@@ -1,9 +1,10 @@
-"""pgae_lite.pipeline.trained_pgae: the chapters' epoch budget, caching by profile; unknown profiles."""
+"""pgae_lite.pipeline.trained_pgae: the profile's recipe, caching by profile; unknown profiles."""
 from __future__ import annotations
 
 import pytest
 
 import pgae_lite.pipeline as pipeline
+from pgae_lite.config import get_profile
 
 UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
 
@@ -21,13 +22,13 @@ def test_an_unknown_profile_is_a_clear_error(call, monkeypatch):
         call(None)
 
 
-def test_chapter_epochs_apply_unless_epochs_are_given(toy_short, monkeypatch):
+def test_chapters_train_the_profiles_recipe_unless_told_otherwise(toy_short, monkeypatch):
     # The toy dataset stands in for the simulated one (recording it is tested in test_simdata).
     monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
-    monkeypatch.setitem(pipeline.CHAPTER_EPOCHS, "smoke", 2)
     small = dict(max_train_samples=8, batch_size=4)
     chapter = pipeline.trained_pgae("PGAE", "smoke", progress=False, **small)
-    assert chapter.profile.train.epochs == 2 and len(chapter.history) == 2
+    recipe = get_profile("smoke").train.epochs
+    assert chapter.profile.train.epochs == recipe and len(chapter.history) == recipe
     explicit = pipeline.trained_pgae("PGAE", "smoke", progress=False, epochs=1, **small)
     assert explicit.profile.train.epochs == 1 and len(explicit.history) == 1
     again = pipeline.trained_pgae("PGAE", "smoke", progress=False, **small)   # cached: the same model

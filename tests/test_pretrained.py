@@ -172,7 +172,7 @@ def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
     index = torch.tensor([72, 0, 100, 1])
     batch = make_batch(toy_tensors, index, signal_ids(["describe", "execute", "repeat language", "repeat both"]),
                        torch.tensor([0, 1, 2, 3]))
-    out = model(batch, teacher_language=True, teacher_joints=True)
+    out = model(batch, teacher_language=True)
     assert out["logits"].shape == (4, 4, 23) and out["joints"].shape == (4, 99, 5)
     (out["logits"].sum() + out["joints"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]

@@ -1,0 +1,50 @@
+"""Wall time of one full-quality training + evaluation: the book recipe against the one it replaced.
+
+    python benchmarks/recipe_time.py [--data PATH] [--threads 2] [--seeds 0]
+
+On the authors' data, one after the other in this one process (the machines
+are shared and noisy: old and new are timed side by side, on the same data,
+under the same load): the previous ``book`` recipe (1,200 epochs of batch 64,
+learning rate 2e-3) and today's (``pgae_lite.config``'s ``book`` profile). Each
+is timed from the first epoch to the last cell of Table 1's PGAE row, and its
+cells are kept, so the speed-up is read next to what it bought. Writes
+results/recipe_time.json.
+"""
+from __future__ import annotations
+
+import time
+
+from harness import Benchmark
+from pgae_lite.data import load_original
+from pgae_lite.config import get_profile
+from pgae_lite.evaluate import evaluate
+from pgae_lite.train import train
+
+#: The ``book`` recipe before this one (pgae_lite 2026-11, README's history): what changed since.
+PREVIOUS = {"epochs": 1200, "batch_size": 64, "lr": 2e-3}
+
+bench = Benchmark("recipe_time", __doc__)
+bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+args = bench.parse()
+dataset = load_original(args.data)
+
+rows = []
+for seed in args.seeds:
+    for name, overrides in (("previous", PREVIOUS), ("recipe", {})):
+        profile = get_profile(args.profile, seed=seed, **overrides)
+        t0 = time.perf_counter()
+        trained = train(dataset, profile, progress=False)
+        train_seconds = time.perf_counter() - t0
+        cells, _ = evaluate(trained.model, dataset, trained.normaliser, joint_range=dataset.joint_range())
+        seconds = time.perf_counter() - t0
+        t = profile.train
+        rows.append({"recipe": name, "seed": seed, "epochs": t.epochs, "batch_size": t.batch_size, "lr": t.lr,
+                     "train_seconds": round(train_seconds, 1), "seconds": round(seconds, 1),
+                     "cells": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}})
+        print(f"seed {seed} {name:8s}: {t.epochs} epochs x batch {t.batch_size}: {seconds / 60:.2f} min "
+              f"(training {train_seconds / 60:.2f}); " + ", ".join(
+                  f"{s} {c['accuracy']:.2f}% / {c['nrmse']:.3f}%" for s, c in cells.items()))
+previous = sum(r["seconds"] for r in rows if r["recipe"] == "previous")
+recipe = sum(r["seconds"] for r in rows if r["recipe"] == "recipe")
+print(f"speed-up: {previous / recipe:.2f}x")
+bench.write({"data": "original", "rows": rows, "speedup": round(previous / recipe, 2)})
