@@ -170,7 +170,7 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
                 nn.utils.clip_grad_norm_(model.parameters(), cfg.clip)
             optimiser.step()
             sums += torch.tensor([loss.item(), lang.item(), act.item()]) * size
-            z = out["gate"].detach().mean(1).cpu()
+            z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
             gate_sum.index_add_(0, signal, z)
             gate_n.index_add_(0, signal, torch.ones(size))
         loss, lang, act = (sums / n).tolist()
