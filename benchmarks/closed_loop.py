@@ -9,7 +9,8 @@ each test episode twice (:func:`pgae_lite.closedloop.compare`): open loop, the
 paper's execute (the decoder reads the recorded vision), and closed loop (it
 reads what its own motion shows). Prints the success rate per action and
 speed and the time per episode; writes the success rates, their gap and every
-failed closed-loop episode to results/closed_loop.json. ``--limit N`` takes N
+failed closed-loop episode to results/closed_loop.json, with the model's Table 1
+cells on the same data (:func:`pgae_lite.evaluate.evaluate`). ``--limit N`` takes N
 episodes evenly spread over the 216 of the test split. The models are small:
 one thread is as fast as two.
 """
@@ -20,6 +21,7 @@ import time
 from harness import Benchmark
 from pgae_lite.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
+from pgae_lite.evaluate import evaluate
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 
 bench = Benchmark("closed_loop", __doc__, seeds=[0, 1, 2])
@@ -44,10 +46,12 @@ for training in args.trainings:
               f"({len(table)} episodes, {seconds / len(table):.2f} s each)")
         print(summary.round(2).to_string())
         failed = table[~table["closed_passed"]]
+        cells, _ = evaluate(trained.model, data, trained.normaliser)
         runs.append({"training": training, "seed": seed, "episodes": len(table),
                      "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
                      "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
                      "seconds_per_episode": round(seconds / len(table), 3),
+                     "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
                      "summary": summary.reset_index().round(2).to_dict(orient="records"),
                      "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
                      .to_dict(orient="records")})
