@@ -61,8 +61,9 @@ class TrainConfig:
     # Deviation from paper: 1200 epochs of batch 64 (paper: 6000 of batch 6 at a 200x smaller learning
     # rate). Measured on our data (benchmarks/explore_recipe.py --sim, seeds 2 and 3): describe 98.15 /
     # 92.59% after 1000 epochs, 97.69 / 99.07% after 1200. A faster candidate, 250 epochs of batch 16 at
-    # 3e-3 with β = 4 (benchmarks/recipe_time.py's FAST), trains in 42% of the time (results/recipe_time.json) but missed Table 1's
-    # describe on two of three seeds of the authors' data (results/fast-250x16-table1-original.json).
+    # 3e-3 with β = 4 (benchmarks/recipe_time.py's FAST), trains in 42% of the time (results/recipe_time.json)
+    # but missed Table 1's describe on two of three seeds of the authors' data
+    # (results/fast-250x16-table1-original.json).
     epochs: int = 1200
     batch_size: int = 64
     # Deviation from paper: AdamW 2e-3 with warm-up and cosine decay (paper: Adam 1e-5, constant).
