@@ -27,14 +27,15 @@ from pgae_lite.reproduce import parse_rows
 
 from harness import Benchmark
 
-source = "sim" if "--sim" in sys.argv else "original"   # names the result file
-bench = Benchmark(f"table1-{source}", __doc__, seeds=[0, 1, 2])
+bench = Benchmark("table1", __doc__, seeds=[0, 1, 2])
 bench.parser.add_argument("--data", default=os.environ.get("PGAE_ORIGINAL_DATA", "../shared/pgae-original-data"))
 bench.parser.add_argument("--sim", action="store_true", help="our simulated data instead of the authors'")
 bench.parser.add_argument("--rows", default="PGAE")
 bench.parser.add_argument("--jobs", type=int, default=1)
 bench.parser.add_argument("--runs", default="benchmarks/out", help="the runs' output folders (resumable)")
 args = bench.parse()
+source = "sim" if args.sim else "original"
+bench.name = f"table1-{source}"            # results/table1-original.json or table1-sim.json
 threads = args.threads or 2
 rows = parse_rows(args.rows)
 

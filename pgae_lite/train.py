@@ -80,11 +80,6 @@ def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | N
     return action_input + scale * noise
 
 
-def epoch_batches(n: int, batch_size: int, gen: torch.Generator) -> list[torch.Tensor]:
-    """One epoch's batches of sample indices 0..n-1, shuffled."""
-    return list(torch.randperm(n, generator=gen).split(batch_size))
-
-
 class DataMismatchError(ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
@@ -145,14 +140,14 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:
         model.train()
-        epoch_index = epoch_batches(n, cfg.batch_size, gen)
+        order = torch.randperm(n, generator=gen)
         sums = torch.zeros(3)
         gate_sum, gate_n = torch.zeros(len(SIGNALS)), torch.zeros(len(SIGNALS))
         for b in range(batches):
             step = epoch * batches + b
             for g in optimiser.param_groups:
                 g["lr"] = cfg.lr * lr_factor(step, total, cfg.warmup, cfg.schedule)
-            index = epoch_index[b]
+            index = order[b * cfg.batch_size:(b + 1) * cfg.batch_size]
             size = len(index)
             signal = sample_signals(size, gen, cfg.signals_per_sample, cfg.signal_probs)
             alternative = torch.randint(8, (size,), generator=gen)
