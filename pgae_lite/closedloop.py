@@ -7,10 +7,11 @@ do: it is open-loop. Here the model's own motion makes the images it reads::
 
     frame_0 = NICO at its start pose                      (as every recording starts)
     h       = encode(signal execute + description, [v_0; j_0])
-    for t = 1 .. T-1:
-        ĵ_t     = decoder.step(v_{t-1}, ĵ_{t-1})          (ĵ_0 = j_0)
-        move the arm so that its joints reach ĵ_t; step the physics; render frame_t
-        v_t     = Normaliser(CAE(frame_t))
+    for t = 0, k, 2k, ... < T-1:                          (k = the model's time_stride, 2 in the book)
+        ĵ_{t+k} = decoder.step(v_t, ĵ_t)                   (ĵ_0 = j_0)
+        for each step s = t+1 .. t+k: move the arm so that its joints reach the point
+            on the line ĵ_t -> ĵ_{t+k}; step the physics; render frame_s
+        v_{t+k} = Normaliser(CAE(frame_{t+k}))
     passed  = the simulator's check: did the named cube move the named way?
 
 Time alignment, as in a recording (:mod:`pgae_lite.sim.record`): the arm
@@ -180,16 +181,18 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
     batch = execute_batch(v[0], j[0], words, device)
     h, _ = model.encode(batch) if language is None else model.encode(batch, language=language)
 
-    decoder, start = model.action_decoder, batch.start_joints
+    decoder, start, k = model.action_decoder, batch.start_joints, model.cfg.time_stride
     state, joints = decoder.begin(h), [start]
-    for _ in range(1, steps):
-        j, state = decoder.step(state, v, j, start)              # ĵ_t from v_{t-1} and ĵ_{t-1}
-        target, frame = _drive(sim, normaliser.joints_to_data(j)[0].cpu().numpy(), tracking, render=True)
-        joints.append(j)
-        frames.append(frame)
-        targets.append(target)
-        measured.append(sim.joints())
-        v = features(frame)
+    for t in range(0, steps - 1, k):                            # t = 0, k, 2k, ...: the steps the model sees
+        planned, state = decoder.step(state, v, j, start)        # ĵ_{t+k} from v_t and ĵ_t
+        for i in range(1, min(k, steps - 1 - t) + 1):           # steps t+1 .. t+k, on the line ĵ_t -> ĵ_{t+k}
+            between = j + (planned - j) * (i / k)
+            target, frame = _drive(sim, normaliser.joints_to_data(between)[0].cpu().numpy(), tracking, render=True)
+            joints.append(between)
+            frames.append(frame)
+            targets.append(target)
+            measured.append(sim.joints())
+        j, v = planned, features(frame)
     return Rollout(pattern, variation, text, np.stack(frames),
                    normaliser.joints_to_data(torch.cat(joints)).cpu().numpy(),
                    np.array(measured), np.array(targets), sim.cube_displacement(), sim.check())

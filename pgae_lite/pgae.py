@@ -219,7 +219,9 @@ class PGAE(nn.Module):
             if f_lang.shape != (len(batch.signal), self.language_encoder.output_dim):
                 raise ValueError(f"language features must be (batch, {self.language_encoder.output_dim}) = "
                                  f"{(len(batch.signal), self.language_encoder.output_dim)}; got {tuple(f_lang.shape)}")
-        f_act = self.action_encoder(batch.action_input, batch.action_lengths)
+        k = self.cfg.time_stride
+        f_act = self.action_encoder(batch.action_input[:, ::k],                  # (B, ceil(T/k), 35)
+                                    torch.div(batch.action_lengths + k - 1, k, rounding_mode="floor"))
         return self.gmu(f_act, f_lang)
 
     def forward(self, batch: SignalBatch, teacher_language: bool = False, feedback: str = "greedy",
@@ -232,8 +234,27 @@ class PGAE(nn.Module):
         h, z = self.encode(batch, language)
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
-        joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, steps=batch.joint_mask.sum(1))
+        k, steps = self.cfg.time_stride, batch.joint_mask.sum(1)
+        plan = self.action_decoder(h, batch.dec_vision[:, ::k], batch.start_joints,  # ĵ_k, ĵ_2k, ... (B, S, 5)
+                                   steps=torch.div(steps + k - 1, k, rounding_mode="floor"))
+        joints = between_plan_steps(batch.start_joints, plan, k, batch.dec_vision.shape[1])  # (B, T-1, 5)
         return {"logits": logits, "joints": joints, "h": h, "gate": z}
+
+
+def between_plan_steps(start: torch.Tensor, plan: torch.Tensor, stride: int, steps: int) -> torch.Tensor:
+    """Joints of steps 1..``steps`` (B, steps, 5) from a plan of every ``stride``-th step.
+
+    ``plan`` (B, S, 5) holds ĵ_k, ĵ_2k, ... (k = ``stride``) and ĵ_0 = ``start`` (B, 5);
+    a step between two planned ones lies on the straight line between them.
+    """
+    if stride == 1:
+        return plan[:, :steps]
+    points = torch.cat([start[:, None], plan], 1)                        # ĵ_0, ĵ_k, ĵ_2k, ... (B, S+1, 5)
+    t = torch.arange(1, steps + 1, device=plan.device)
+    before = torch.div(t, stride, rounding_mode="floor")                # planned step at or before t
+    after = (before + 1).clamp(max=points.shape[1] - 1)
+    w = ((t % stride) / stride)[None, :, None].to(plan.dtype)          # (1, steps, 1)
+    return points[:, before] * (1 - w) + points[:, after] * w             # (B, steps, 5)
 
 
 def count_parameters(model: nn.Module) -> int:
