@@ -5,7 +5,7 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig
-from pgae_lite.pgae import PGAE, count_parameters
+from pgae_lite.pgae import PGAE, between_plan_steps, count_parameters
 from pgae_lite.signals import make_batch, signal_ids
 
 INDEX = torch.tensor([72, 0, 100, 1])          # fast, slow, fast, slow (toy training samples)
@@ -111,3 +111,32 @@ def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, ce
     mask = b.joint_mask[..., None].expand_as(full)
     torch.testing.assert_close(short[mask], full[mask])
     assert (short[~mask] == 0).all()
+
+
+def test_time_stride_plans_every_kth_pose_and_draws_lines_between():
+    start, plan = torch.zeros(1, 5), torch.arange(1.0, 4.0)[None, :, None].expand(1, 3, 5)  # ĵ_2 = 1, ĵ_4 = 2, ĵ_6 = 3
+    joints = between_plan_steps(start, plan, 2, 5)                                          # steps 1..5
+    torch.testing.assert_close(joints[0, :, 0], torch.tensor([0.5, 1.0, 1.5, 2.0, 2.5]))
+    assert torch.equal(between_plan_steps(start, plan, 1, 3), plan)
+
+
+@pytest.mark.parametrize("stride", [2, 3])
+def test_a_strided_model_reads_only_every_kth_step(toy_tensors, stride):
+    model = PGAE(ModelConfig(units=16, time_stride=stride)).eval()
+    b, changed = _batch(toy_tensors), _batch(toy_tensors)
+    skipped = torch.ones(changed.action_input.shape[1], dtype=torch.bool)
+    skipped[::stride] = False                                         # the steps the model reads
+    changed.action_input[:, skipped] += 0.5
+    changed.dec_vision[:, skipped[:changed.dec_vision.shape[1]]] += 0.5
+    with torch.no_grad():
+        out, out_changed = model(b), model(changed)
+        assert torch.equal(out["joints"], out_changed["joints"]) and torch.equal(out["h"], out_changed["h"])
+        changed.dec_vision[:, 0] += 0.5                               # a step it reads
+        assert not torch.equal(out["joints"], model(changed)["joints"])
+    assert out["joints"].shape == b.joint_target.shape
+
+
+def test_time_stride_must_be_a_positive_whole_number():
+    for bad in (0, -1, 1.5):
+        with pytest.raises(ValueError, match="time_stride"):
+            ModelConfig(time_stride=bad)
