@@ -8,9 +8,9 @@ do: it is open-loop. Here the model's own motion makes the images it reads::
     frame_0 = NICO at its start pose                      (as every recording starts)
     h       = encode(signal execute + description, [v_0; j_0])
     for t = 0, k, 2k, ... < T-1:                          (k = the model's time_stride, 2 in the book)
-        ĵ_{t+k} = decoder.step(v_t, ĵ_t)                   (ĵ_0 = j_0)
-        for each step s = t+1 .. t+k: move the arm so that its joints reach the point
-            on the line ĵ_t -> ĵ_{t+k}; step the physics; render frame_s
+        ĵ_{t+1} .. ĵ_{t+k} = decoder.step(v_t, ĵ_t)        (ĵ_0 = j_0)
+        for each s = t+1 .. t+k: move the arm so that its joints reach ĵ_s;
+            step the physics; render frame_s
         v_{t+k} = Normaliser(CAE(frame_{t+k}))
     passed  = the simulator's check: did the named cube move the named way?
 
@@ -183,16 +183,15 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
 
     decoder, start, k = model.action_decoder, batch.start_joints, model.cfg.time_stride
     state, joints = decoder.begin(h), [start]
-    for t in range(0, steps - 1, k):                            # t = 0, k, 2k, ...: the steps the model sees
-        planned, state = decoder.step(state, v, j, start)        # ĵ_{t+k} from v_t and ĵ_t
-        for i in range(1, min(k, steps - 1 - t) + 1):           # steps t+1 .. t+k, on the line ĵ_t -> ĵ_{t+k}
-            between = j + (planned - j) * (i / k)
-            target, frame = _drive(sim, normaliser.joints_to_data(between)[0].cpu().numpy(), tracking, render=True)
-            joints.append(between)
+    for t in range(0, steps - 1, k):                            # t = 0, k, 2k, ...: the frames the model reads
+        poses, state = decoder.step(state, v, j, start)          # ĵ_{t+1} .. ĵ_{t+k} from v_t and ĵ_t, (1, 5k)
+        for j in poses.reshape(k, 1, -1)[:steps - 1 - t]:        # k x (1, 5), within the episode
+            target, frame = _drive(sim, normaliser.joints_to_data(j)[0].cpu().numpy(), tracking, render=True)
+            joints.append(j)
             frames.append(frame)
             targets.append(target)
             measured.append(sim.joints())
-        j, v = planned, features(frame)
+        v = features(frame)                                      # v_{t+k}
     return Rollout(pattern, variation, text, np.stack(frames),
                    normaliser.joints_to_data(torch.cat(joints)).cpu().numpy(),
                    np.array(measured), np.array(targets), sim.cube_displacement(), sim.check())

@@ -10,6 +10,11 @@ Two autoencoders, language and action, joined in a GMU bottleneck:
 
 Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50,
 30 visual features and 5 joints per step.
+
+Deviation from paper: with ``time_stride`` k (2 in the book) one step of the
+action LSTMs covers k time steps: the encoder reads every k-th step, x_0, x_k,
+...; the decoder reads v_t and writes [ĵ_{t+1}; ...; ĵ_{t+k}], every pose.
+Half the LSTM steps.
 """
 from __future__ import annotations
 
@@ -68,14 +73,22 @@ def make_language_encoder(cfg: ModelConfig) -> nn.Module:
 
 
 class ActionEncoder(nn.Module):
-    """LSTM over [visual features; joints] per step; f = final [c; h] of every layer."""
+    """LSTM over [visual features; joints] per step; f = final [c; h] of every layer.
+
+    With ``time_stride`` k > 1 it reads every k-th step: x_0, x_k, x_2k, ...
+    """
 
     def __init__(self, cfg: ModelConfig):
         super().__init__()
+        self.stride = cfg.time_stride
         self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
 
     def forward(self, inputs: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
-        _, state = self.rnn(inputs, lengths)                    # inputs (B, T, 35)
+        k = self.stride                                         # inputs (B, T, 35), lengths (B,)
+        if k > 1:
+            inputs = inputs[:, ::k]                             # (B, ceil(T/k), 35)
+            lengths = torch.div(lengths + k - 1, k, rounding_mode="floor")
+        _, state = self.rnn(inputs, lengths)
         return state_to_vector(state)                           # (B, 400)
 
 
@@ -137,9 +150,10 @@ class ActionDecoder(nn.Module):
             raise ValueError(f"unknown joint_feedback {cfg.joint_feedback!r}; the options are: predicted, start")
         self.layers = cfg.layers
         self.feedback = cfg.joint_feedback
+        self.stride = cfg.time_stride                           # poses written per step
         self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)
         self.rnn = make_recurrent(cfg.cell, VISION_DIM + JOINT_DIM, cfg.units, cfg.layers)
-        self.out = nn.Linear(cfg.units, JOINT_DIM)
+        self.out = nn.Linear(cfg.units, JOINT_DIM * self.stride)
 
     def begin(self, h: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """The LSTM's initial state (h, c), each (layers, B, units), from the shared representation h: W h + b."""
@@ -149,9 +163,11 @@ class ActionDecoder(nn.Module):
              start: torch.Tensor) -> tuple[torch.Tensor, tuple[torch.Tensor, torch.Tensor]]:
         """One step: v_t (B, 30), ĵ_t (B, 5), start joints (B, 5) -> ĵ_{t+1} (B, 5) and the new state.
 
-        With ``joint_feedback="start"`` the decoder reads ``start`` in place of ĵ_t.
+        With ``joint_feedback="start"`` the decoder reads ``start`` in place of ĵ_t. With
+        ``time_stride`` k > 1 a step writes the next k poses, ĵ_{t+1} .. ĵ_{t+k}, side by
+        side (B, 5k); ``j_t`` may be such a step's output (its last pose is ĵ_t).
         """
-        joints_in = start if self.feedback == "start" else j_t
+        joints_in = start if self.feedback == "start" else j_t[:, -JOINT_DIM:]
         y, state = self.rnn.step(torch.cat([v_t, joints_in], 1), state)
         return torch.tanh(self.out(y)), state
 
@@ -161,18 +177,33 @@ class ActionDecoder(nn.Module):
 
         ``steps`` (B,), if given, is how many steps each sample needs: a free-running
         decoder then stops computing a sample after its last step (outputs 0 there).
+        With ``time_stride`` k > 1 it reads v_0, v_k, v_2k, ... and writes k poses
+        after each (:meth:`step`).
         """
-        state = self.begin(h)
-        if self.feedback == "start":
-            # Deviation from paper: the decoder reads the start joints at every step instead of
-            # its own predictions, so its small errors cannot feed back and grow, and training
-            # and test run the same single fused pass over all steps.
-            prev = start[:, None].expand(-1, vision.shape[1], -1)             # (B, S, 5)
-            y, _ = self.rnn(torch.cat([vision, prev], 2), steps, state)      # each sample for its own steps
-            joints = torch.tanh(self.out(y))                                  # (B, S, 5)
-            if steps is not None:                                             # 0 past a sample's last step
-                joints = joints * (torch.arange(vision.shape[1], device=vision.device) < steps[:, None])[..., None]
-            return joints
+        k, S = self.stride, vision.shape[1]
+        run = self._fused if self.feedback == "start" else self._free_running
+        if k == 1:
+            return run(self.begin(h), vision, start, steps)
+        lstm_steps = None if steps is None else torch.div(steps + k - 1, k, rounding_mode="floor")
+        poses = run(self.begin(h), vision[:, ::k], start, lstm_steps)         # (B, ceil(S/k), 5k)
+        joints = poses.reshape(len(h), -1, JOINT_DIM)[:, :S]                  # (B, S, 5)
+        if steps is not None:                                                 # 0 past a sample's last step
+            joints = joints * (torch.arange(S, device=vision.device) < steps[:, None])[..., None]
+        return joints
+
+    def _fused(self, state, vision: torch.Tensor, start: torch.Tensor, steps: torch.Tensor | None) -> torch.Tensor:
+        # Deviation from paper: the decoder reads the start joints at every step instead of
+        # its own predictions, so its small errors cannot feed back and grow, and training
+        # and test run the same single fused pass over all steps.
+        prev = start[:, None].expand(-1, vision.shape[1], -1)                 # (B, S, 5)
+        y, _ = self.rnn(torch.cat([vision, prev], 2), steps, state)          # each sample for its own steps
+        joints = torch.tanh(self.out(y))                                      # (B, S, 5k)
+        if steps is not None:                                                 # 0 past a sample's last step
+            joints = joints * (torch.arange(vision.shape[1], device=vision.device) < steps[:, None])[..., None]
+        return joints
+
+    def _free_running(self, state, vision: torch.Tensor, start: torch.Tensor,
+                      steps: torch.Tensor | None) -> torch.Tensor:
         B, S, _ = vision.shape
         if steps is None:
             steps = torch.full((B,), S, device=vision.device)
@@ -183,13 +214,13 @@ class ActionDecoder(nn.Module):
         state = (state[0][:, order], state[1][:, order])
         j, outs = start, []
         for t, v_t in enumerate(vision.unbind(1)):              # S x (B, 30)
-            k = active[t]
-            if k == 0:
+            n = active[t]
+            if n == 0:
                 break
-            state = (state[0][:, :k], state[1][:, :k])
-            j, state = self.step(state, v_t[:k], j[:k], start[:k])   # ĵ_{t+1}, (k, 5)
-            outs.append(nn.functional.pad(j, (0, 0, 0, B - k)))
-        joints = torch.stack(outs, 1)                           # (B, S', 5), S' <= S
+            state = (state[0][:, :n], state[1][:, :n])
+            j, state = self.step(state, v_t[:n], j[:n], start[:n])   # ĵ_{t+1}, (n, 5k)
+            outs.append(nn.functional.pad(j, (0, 0, 0, B - n)))
+        joints = torch.stack(outs, 1)                           # (B, S', 5k), S' <= S
         joints = nn.functional.pad(joints, (0, 0, 0, S - joints.shape[1]))
         return torch.empty_like(joints).index_copy_(0, order, joints)   # back to the batch's order
 
@@ -219,9 +250,7 @@ class PGAE(nn.Module):
             if f_lang.shape != (len(batch.signal), self.language_encoder.output_dim):
                 raise ValueError(f"language features must be (batch, {self.language_encoder.output_dim}) = "
                                  f"{(len(batch.signal), self.language_encoder.output_dim)}; got {tuple(f_lang.shape)}")
-        k = self.cfg.time_stride
-        f_act = self.action_encoder(batch.action_input[:, ::k],                  # (B, ceil(T/k), 35)
-                                    torch.div(batch.action_lengths + k - 1, k, rounding_mode="floor"))
+        f_act = self.action_encoder(batch.action_input, batch.action_lengths)
         return self.gmu(f_act, f_lang)
 
     def forward(self, batch: SignalBatch, teacher_language: bool = False, feedback: str = "greedy",
@@ -234,27 +263,8 @@ class PGAE(nn.Module):
         h, z = self.encode(batch, language)
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
-        k, steps = self.cfg.time_stride, batch.joint_mask.sum(1)
-        plan = self.action_decoder(h, batch.dec_vision[:, ::k], batch.start_joints,  # ĵ_k, ĵ_2k, ... (B, S, 5)
-                                   steps=torch.div(steps + k - 1, k, rounding_mode="floor"))
-        joints = between_plan_steps(batch.start_joints, plan, k, batch.dec_vision.shape[1])  # (B, T-1, 5)
+        joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, steps=batch.joint_mask.sum(1))
         return {"logits": logits, "joints": joints, "h": h, "gate": z}
-
-
-def between_plan_steps(start: torch.Tensor, plan: torch.Tensor, stride: int, steps: int) -> torch.Tensor:
-    """Joints of steps 1..``steps`` (B, steps, 5) from a plan of every ``stride``-th step.
-
-    ``plan`` (B, S, 5) holds ĵ_k, ĵ_2k, ... (k = ``stride``) and ĵ_0 = ``start`` (B, 5);
-    a step between two planned ones lies on the straight line between them.
-    """
-    if stride == 1:
-        return plan[:, :steps]
-    points = torch.cat([start[:, None], plan], 1)                        # ĵ_0, ĵ_k, ĵ_2k, ... (B, S+1, 5)
-    t = torch.arange(1, steps + 1, device=plan.device)
-    before = torch.div(t, stride, rounding_mode="floor")                # planned step at or before t
-    after = (before + 1).clamp(max=points.shape[1] - 1)
-    w = ((t % stride) / stride)[None, :, None].to(plan.dtype)          # (1, steps, 1)
-    return points[:, before] * (1 - w) + points[:, after] * w             # (B, steps, 5)
 
 
 def count_parameters(model: nn.Module) -> int:

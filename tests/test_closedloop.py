@@ -22,17 +22,19 @@ PATTERN = 116   # slide the left cube (cyan) fast: a test pattern of the smoke s
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 @pytest.mark.parametrize("feedback", ["predicted", "start"])
-def test_stepping_the_decoder_gives_what_forward_gives(cell, feedback):
-    decoder = ActionDecoder(ModelConfig(units=16, hidden=8, cell=cell, joint_feedback=feedback)).eval()
+@pytest.mark.parametrize("stride", [1, 2])
+def test_stepping_the_decoder_gives_what_forward_gives(cell, feedback, stride):
+    decoder = ActionDecoder(ModelConfig(units=16, hidden=8, cell=cell, joint_feedback=feedback,
+                                        time_stride=stride)).eval()
     h, vision, start = torch.randn(3, 8), torch.randn(3, 7, 30), torch.rand(3, 5) * 2 - 1
     lengths = torch.tensor([7, 4, 7])
     with torch.no_grad():
         whole = decoder(h, vision, start, steps=lengths)              # (3, 7, 5)
         state, j, stepped = decoder.begin(h), start, []
-        for t in range(7):
+        for t in range(0, 7, stride):                                 # a step writes `stride` poses
             j, state = decoder.step(state, vision[:, t], j, start)
-            stepped.append(j)
-    stepped = torch.stack(stepped, 1)
+            stepped.append(j.reshape(3, stride, 5))
+    stepped = torch.cat(stepped, 1)[:, :7]
     valid = torch.arange(7)[None] < lengths[:, None]
     assert torch.allclose(whole[valid], stepped[valid], atol=1e-5)
 
@@ -52,13 +54,13 @@ def test_closed_loop_starts_like_the_recording_and_is_deterministic(smoke):
     assert run.frames.shape == (50, 120, 160, 3) and run.frames.dtype == np.uint8
     assert run.joints.shape == run.measured.shape == run.targets.shape == (50, 5)
     assert run.description == "slide cyan fast"
-    # Step 0 is the recording's step 0, bit for bit; so the first plan is the paper's execute's.
+    # Step 0 is the recording's step 0, bit for bit; so the first poses are the paper's execute's.
     episode = load_episode(SMOKE, PATTERN, 0)
     assert np.array_equal(run.frames[0], episode.images[0])
     assert np.allclose(run.joints[0], episode.joints[0], atol=1e-6)
     i = int(np.flatnonzero(data.ids == f"sim/{PATTERN:03d}-0")[0])
     paper = predict(model, data.subset([i]), normaliser, "execute").joints[0]
-    k = model.cfg.time_stride                                             # the first plan reads v_0 only
+    k = model.cfg.time_stride                                  # the first decoder step reads v_0 only
     assert k == 2 and np.allclose(run.joints[:k + 1], paper[:k + 1], atol=1e-4)
     again = closed_loop(model, cae, normaliser, PATTERN, 0, config=SMOKE)
     assert np.array_equal(run.joints, again.joints) and np.array_equal(run.frames, again.frames)

@@ -5,7 +5,7 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig
-from pgae_lite.pgae import PGAE, between_plan_steps, count_parameters
+from pgae_lite.pgae import PGAE, count_parameters
 from pgae_lite.signals import make_batch, signal_ids
 
 INDEX = torch.tensor([72, 0, 100, 1])          # fast, slow, fast, slow (toy training samples)
@@ -29,7 +29,7 @@ def test_shapes(toy_tensors, cell):
 
 
 def test_parameter_count_is_the_authors():
-    assert count_parameters(PGAE(ModelConfig(cell="peephole"))) == 657_778
+    assert count_parameters(PGAE(ModelConfig(cell="peephole", time_stride=1))) == 657_778
     assert ModelConfig().state_dim == 400
 
 
@@ -45,7 +45,10 @@ def test_model_config_defaults_are_the_book_recipe():
 def test_fused_parameter_count():
     """nn.LSTM has two bias vectors and no peepholes: 4·H extra − 3·H per layer."""
     per_layer = 100                                                # 4H − 3H
-    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer
+    assert count_parameters(PGAE(ModelConfig(time_stride=1))) == 657_778 + 4 * 2 * per_layer
+    # time_stride 2: the decoder writes 5 more joints per step
+    stride2 = 5 * (100 + 1)
+    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer + stride2
 
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
@@ -113,27 +116,28 @@ def test_free_running_decoder_stops_each_sample_after_its_length(toy_tensors, ce
     assert (short[~mask] == 0).all()
 
 
-def test_time_stride_plans_every_kth_pose_and_draws_lines_between():
-    start, plan = torch.zeros(1, 5), torch.arange(1.0, 4.0)[None, :, None].expand(1, 3, 5)  # ĵ_2 = 1, ĵ_4 = 2, ĵ_6 = 3
-    joints = between_plan_steps(start, plan, 2, 5)                                          # steps 1..5
-    torch.testing.assert_close(joints[0, :, 0], torch.tensor([0.5, 1.0, 1.5, 2.0, 2.5]))
-    assert torch.equal(between_plan_steps(start, plan, 1, 3), plan)
-
-
 @pytest.mark.parametrize("stride", [2, 3])
-def test_a_strided_model_reads_only_every_kth_step(toy_tensors, stride):
-    model = PGAE(ModelConfig(units=16, time_stride=stride)).eval()
+@pytest.mark.parametrize("feedback", ["start", "predicted"])
+def test_a_strided_model_reads_every_kth_frame_and_writes_every_pose(toy_tensors, stride, feedback):
+    model = PGAE(ModelConfig(units=16, time_stride=stride, joint_feedback=feedback)).eval()
     b, changed = _batch(toy_tensors), _batch(toy_tensors)
-    skipped = torch.ones(changed.action_input.shape[1], dtype=torch.bool)
-    skipped[::stride] = False                                         # the steps the model reads
-    changed.action_input[:, skipped] += 0.5
-    changed.dec_vision[:, skipped[:changed.dec_vision.shape[1]]] += 0.5
+    unread = torch.ones(changed.dec_vision.shape[1], dtype=torch.bool)
+    unread[::stride] = False                                          # the frames the decoder reads
+    changed.dec_vision[:, unread] += 0.5
     with torch.no_grad():
-        out, out_changed = model(b), model(changed)
-        assert torch.equal(out["joints"], out_changed["joints"]) and torch.equal(out["h"], out_changed["h"])
-        changed.dec_vision[:, 0] += 0.5                               # a step it reads
-        assert not torch.equal(out["joints"], model(changed)["joints"])
+        out = model(b)
+        assert torch.equal(out["joints"], model(changed)["joints"])
+        changed.dec_vision[:, stride] += 0.5                          # a frame it reads: the poses after it change
+        moved = (model(changed)["joints"] != out["joints"]).any(2).any(0)
     assert out["joints"].shape == b.joint_target.shape
+    assert not moved[:stride].any() and moved[stride:2 * stride].all()
+    # The encoder reads every stride-th step only.
+    b2 = _batch(toy_tensors)
+    b2.action_input[:, 1::stride] += 0.5
+    with torch.no_grad():
+        assert torch.equal(model(b2)["h"], out["h"])
+        b2.action_input[:, stride] += 0.5
+        assert not torch.equal(model(b2)["h"][b2.action_lengths > stride], out["h"][b2.action_lengths > stride])
 
 
 def test_time_stride_must_be_a_positive_whole_number():

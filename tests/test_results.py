@@ -1,0 +1,73 @@
+"""Results are data: every committed result file is complete, and every quote of one agrees with it.
+
+The drift test: the README's headline table must be what ``python -m pgae_lite.results
+--readme`` writes from results/table1-original.json today; every figure a chapter or
+the introduction quotes goes through ``pgae_lite.results`` (``results.quote(...)`` in
+a code cell, shown with glue), and every such quote must resolve in its file.
+"""
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+import pytest
+
+from pgae_lite import results
+
+ROOT = Path(__file__).resolve().parent.parent
+QUOTE = re.compile(r"results\.(?:quote|value)\(\s*([\"'][^)]*)\)")
+
+
+def test_every_result_file_says_how_it_was_made():
+    assert results.names(), "no result files in results/"
+    for name in results.names():
+        r = results.load(name)
+        missing = {"benchmark", "command", "commit", "date", "machine", "profile", "seeds", "data"} - set(r)
+        assert not missing, f"results/{name}.json lacks {sorted(missing)}"
+        assert r["command"].startswith("python benchmarks/"), f"results/{name}.json: not made by a benchmark"
+        assert re.fullmatch(r"[0-9a-f]{7,40}( \(\+ uncommitted changes\))?", r["commit"]), r["commit"]
+        assert "cpu" in r["machine"] and "threads" in r["machine"]
+
+
+def test_the_readme_headline_table_is_the_one_the_result_file_gives():
+    readme = (ROOT / "README.md").read_text()
+    assert results.readme_with_headline(readme) == readme, (
+        "README.md's headline table differs from results/table1-original.json: "
+        "run `python -m pgae_lite.results --readme`")
+
+
+def quotes_in(path: Path) -> list[tuple[str, ...]]:
+    """The (name, key, ...) of every results.quote/value call in a notebook's code or a Markdown file."""
+    if path.suffix == ".ipynb":
+        text = "\n".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"]
+                         if c["cell_type"] == "code")
+    else:
+        text = path.read_text()
+    found = []
+    for args in QUOTE.findall(text):
+        keys = re.findall(r"[\"']([^\"']+)[\"']|(?<![\w.])(\d+)(?![\w.])", args.split("digits")[0])
+        found.append(tuple(a or int(b) for a, b in keys))
+    return found
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "notebooks").glob("*.ipynb")) + [ROOT / "book" / "intro.md"],
+                         ids=lambda p: p.name)
+def test_every_quoted_figure_is_in_its_result_file(path):
+    for name, *keys in quotes_in(path):
+        value = results.value(name, *keys)            # KeyError/FileNotFoundError if the quote has drifted
+        assert isinstance(value, (int, float)), f"{path.name}: {name} {keys} is not a number"
+
+
+def test_quotes_are_found_by_the_drift_test():
+    """The test above must see the quotes that the chapters make (it can fail)."""
+    quoted = [q for p in sorted((ROOT / "notebooks").glob("*.ipynb")) for q in quotes_in(p)]
+    assert quoted, "no chapter quotes a result file"
+    with pytest.raises(KeyError, match="has no 'no such key'"):
+        results.value(quoted[0][0], "no such key")
+
+
+def test_a_missing_result_file_is_a_clear_error(tmp_path, monkeypatch):
+    monkeypatch.setenv(results.RESULTS_ENV, str(tmp_path))
+    with pytest.raises(FileNotFoundError, match="the result files are: none"):
+        results.load("table1-original")
