@@ -14,9 +14,9 @@ from __future__ import annotations
 import time
 
 from harness import Benchmark
-from pgae_lite.data import load_original
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
+from pgae_lite.original import load_original
 from pgae_lite.train import train
 
 #: The candidate: what it changes in the book recipe (four times the updates per epoch, a fifth of the epochs).
