@@ -11,8 +11,8 @@ import torch
 from dataclasses import replace
 
 from pgae_lite.config import get_profile
-from pgae_lite.data import load_original
 from pgae_lite.evaluate import evaluate
+from pgae_lite.original import load_original
 from pgae_lite.pipeline import simulated_dataset
 from pgae_lite.train import train
 

@@ -89,6 +89,8 @@ class Benchmark:
 
     def write(self, data: dict, **fields) -> Path:
         """``data`` with the command, commit, date and machine, to :attr:`path` (atomically)."""
+        from pgae_lite.utils import atomic_write_text     # here: torch loads only when a result is written
+
         args = self.args or argparse.Namespace(profile=None, seeds=None, threads=None)
         report = {"benchmark": self.name,
                   "command": " ".join(["python", shlex.quote(os.path.relpath(sys.argv[0], ROOT))]
@@ -99,8 +101,6 @@ class Benchmark:
                   "seconds": round(time.perf_counter() - self.t0, 1), **fields, "data": data}
         path = self.path
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-        tmp.write_text(json.dumps(report, indent=1, allow_nan=False) + "\n")
-        os.replace(tmp, path)
+        atomic_write_text(path, json.dumps(report, indent=1, allow_nan=False) + "\n")
         print(f"written to {os.path.relpath(path)}")
         return path

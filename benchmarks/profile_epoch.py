@@ -32,8 +32,9 @@ from torch.profiler import ProfilerActivity, profile
 
 from harness import Benchmark
 from pgae_lite.config import get_profile
-from pgae_lite.data import JOINT_DIM, VISION_DIM, load_original
+from pgae_lite.data import JOINT_DIM, VISION_DIM
 from pgae_lite.language import INPUT_DIM, VOCABULARY
+from pgae_lite.original import load_original
 from pgae_lite.signals import ACTION_IN, LANG_IN, SIGNAL_PROBS
 from pgae_lite.train import train
 

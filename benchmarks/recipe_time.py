@@ -17,9 +17,9 @@ import time
 from dataclasses import replace
 
 from harness import Benchmark
-from pgae_lite.data import load_original
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
+from pgae_lite.original import load_original
 from pgae_lite.train import train
 
 #: The recipe before: what it changes in today's book recipe (its training, and its model's time stride).

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pgae_lite.data import Pattern
+from pgae_lite.patterns import Pattern, pattern_number
 from pgae_lite.sim import SimConfig, Simulation, record_episode
 
 OUT = Path(__file__).resolve().parent / "out" / "sim_speed.jsonl"
@@ -75,7 +75,7 @@ def main() -> None:
     print(f"render: {frames['render_ms']:.2f} ms/frame (best {frames['render_best_ms']:.2f}); "
           f"full TinyRenderer pass: {frames['full_render_ms']:.2f} ms")
 
-    jobs = [(72 * s + 6 * a + i, args.variation) for a in args.arrangements for s in (0, 1) for i in range(6)]
+    jobs = [(pattern_number(s, a, i), args.variation) for a in args.arrangements for s in (0, 1) for i in range(6)]
     record_episode(*jobs[0])                               # warm up (imports, URDF file)
     t0 = time.perf_counter()
     if args.workers > 1:

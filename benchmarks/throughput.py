@@ -16,8 +16,9 @@ import time
 import torch
 
 from pgae_lite.config import ModelConfig
-from pgae_lite.data import Normaliser, load_original
+from pgae_lite.data import Normaliser
 from pgae_lite.language import word_weights
+from pgae_lite.original import load_original
 from pgae_lite.pgae import PGAE
 from pgae_lite.signals import make_batch, sample_signals
 from pgae_lite.train import pgae_loss

@@ -7,7 +7,9 @@ Modules, in the order the book introduces them:
 - ``cae``         the channel-separated convolutional autoencoder (chapter 03)
 - ``pipeline``    simulator -> CAE -> features -> trained models, each step cached
 - ``language``    vocabulary, synonyms, signals, parsing and errors (chapter 04)
-- ``data``        the dataset type, the 144 patterns and the split, the authors' data loader
+- ``patterns``    the 144 patterns, their numbering and the test split (chapters 01, 02)
+- ``data``        the dataset type and its normalisation (with whitening)
+- ``original``    the authors' data loader (appendix A1)
 - ``toydata``     a small synthetic dataset with the paper's structure (tests, quick demos)
 - ``layers``      peephole LSTM, fused LSTM, Gated Multimodal Unit
 - ``pgae``        encoders, decoders and the PGAE model
@@ -18,11 +20,12 @@ Modules, in the order the book introduces them:
 - ``evaluate``    Table 1: description accuracy and joint nRMSE
 - ``pretrained``  PGAE-BERT's frozen transformer language encoder (chapter 05)
 - ``reproduce``   every row of Table 1 (PGAE, PGAE-BERT, PGAE-self, PGAE-opposite) over seeds
-- ``closedloop``  the model drives the simulated robot; free-form instructions (chapter 07)
+- ``closedloop``  the model drives the simulated robot, open and closed loop (chapter 07)
+- ``instructions`` free-form instructions, executed both ways (chapter 07)
 - ``paraphrases`` held-out free-form paraphrases of the test instructions
 - ``playground``  one signal on one episode, and its ipywidgets front end (chapter 08)
-- ``exercises``   check functions: a student's code against the package's, and what is wrong
-- ``viz``         plots and animations for the chapters
+- ``exercises``   check functions: a student's code against the package's, and what is wrong (by chapter)
+- ``viz``         plots and animations for the chapters (by topic: scenes, vision, model, embeddings)
 - ``utils``       plumbing: the cache folder, the device, atomic writes, config digests
 
 Command line: ``python -m pgae_lite --help`` (simulate, reproduce).

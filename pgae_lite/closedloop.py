@@ -35,20 +35,12 @@ replay then passes 216 of 216. ``tracking=False`` sends ĵ_t as it is (what
 paper's execute, from :func:`pgae_lite.evaluate.predict`) the same way;
 :func:`compare` runs both over a set of episodes.
 
-Free-form instructions (paper, Sec. 3 and 5: PGAE-BERT "has the potential to
-recognise unseen natural language"). :func:`execute_paraphrases` gives every
-test episode one of the held-out paraphrases of its own instruction
-(:mod:`pgae_lite.paraphrases`, e.g. "Could you shove the crimson cube forward
-in a hurry" for "push red fast") and executes it both ways, through
-:func:`instruction_features` (PGAE-BERT's transformer reads any text; PGAE's
-LSTM only its vocabulary, and says which words it does not know) and
-:func:`paper_execute` (the open loop with those features).
+Free-form instructions, executed both ways, are in :mod:`pgae_lite.instructions`.
 """
 from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -57,15 +49,13 @@ from tqdm.auto import tqdm
 
 from .cae import ChannelSeparatedCAE, extract_features
 from .config import PROFILES
-from .data import ACTION_SIDES, ARRANGEMENTS, Normaliser, Pattern, PGAEDataset, description_text
+from .data import Normaliser, PGAEDataset, description_text
 from .evaluate import predict
-from .language import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
-from .paraphrases import Paraphrase, load_paraphrases
+from .language import WORD_INDEX, parse_description, tokenize
+from .patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
 from .pgae import PGAE
-from .pretrained import input_text
-from .signals import EOS, SIGNAL_TOKEN, SignalBatch, make_batch, signal_ids
-from .sim.actions import ActionCheck
-from .sim.record import Simulation
+from .signals import SignalBatch, make_batch, signal_ids
+from .sim.record import Execution, Simulation
 from .sim.robot import HOME_POSE
 from .simdata import DatasetConfig
 from .viz import animate_frames
@@ -73,26 +63,6 @@ from .viz import animate_frames
 #: pybullet's default gain of a position motor (Robot.set_targets sets none): each physics
 #: step closes this share of the gap between the joint and its target.
 POSITION_GAIN = 0.1
-
-
-@dataclass
-class Rollout:
-    """One execution in the simulator: what was asked, what the arm did, what the cubes did."""
-
-    pattern: int               # the scene (and the action the check expects)
-    variation: int
-    description: str           # the words given to the model ("" when none)
-    frames: np.ndarray | None  # (T, 120, 160, 3) uint8, NICO's eye after each step (None: not rendered)
-    joints: np.ndarray         # (T, 5) joints asked for, data units (our simulator's: radians):
-                               # step 0 = the start joints, then ĵ_1..ĵ_{T-1}
-    measured: np.ndarray       # (T, 5) radians, the arm's joints after each step
-    targets: np.ndarray        # (T, 5) radians, the motor targets sent at each step
-    displacement: np.ndarray   # (2, 3) metres, left and right cube
-    check: ActionCheck         # the simulator's check of the pattern's action
-
-    @property
-    def passed(self) -> bool:
-        return self.check.passed
 
 
 @functools.lru_cache(maxsize=2)
@@ -146,7 +116,7 @@ def execute_batch(vision: np.ndarray, joints: np.ndarray, words: tuple[str, ...]
 def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, pattern: int,
                 variation: int = 0, description: str | None = None, *, alternative: int = 0,
                 config: DatasetConfig | None = None, steps: int | None = None,
-                language: torch.Tensor | None = None, tracking: bool = True) -> Rollout:
+                language: torch.Tensor | None = None, tracking: bool = True) -> Execution:
     """Let ``model`` execute a description in the scene of (``pattern``, ``variation``), seeing its own motion.
 
     ``description`` defaults to the pattern's ``alternative``-th description;
@@ -192,13 +162,12 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
             targets.append(target)
             measured.append(sim.joints())
         v = features(frame)                                      # v_{t+k}
-    return Rollout(pattern, variation, text, np.stack(frames),
-                   normaliser.joints_to_data(torch.cat(joints)).cpu().numpy(),
-                   np.array(measured), np.array(targets), sim.cube_displacement(), sim.check())
+    return Execution(pattern, variation, np.stack(frames), normaliser.joints_to_data(torch.cat(joints)).cpu().numpy(),
+                     np.array(measured), np.array(targets), sim.cube_displacement(), sim.check(), text)
 
 
 def open_loop(joints: np.ndarray, pattern: int, variation: int = 0, *, description: str = "",
-              config: DatasetConfig | None = None, tracking: bool = True, render: bool = False) -> Rollout:
+              config: DatasetConfig | None = None, tracking: bool = True, render: bool = False) -> Execution:
     """Execute a joint trajectory computed in advance, (T, 5) radians, step 0 = start joints.
 
     E.g. the paper's execute (``predict(..., "execute").joints``) or a recording's own joints.
@@ -213,12 +182,11 @@ def open_loop(joints: np.ndarray, pattern: int, variation: int = 0, *, descripti
         frames.append(frame)
         targets.append(target)
         measured.append(sim.joints())
-    return Rollout(pattern, variation, description, np.stack(frames) if render else None,
-                   np.asarray(joints, dtype=np.float32), np.array(measured), np.array(targets),
-                   sim.cube_displacement(), sim.check())
+    return Execution(pattern, variation, np.stack(frames) if render else None, np.asarray(joints, dtype=np.float32),
+                     np.array(measured), np.array(targets), sim.cube_displacement(), sim.check(), description)
 
 
-def _variation(sample_id: str) -> int:
+def variation_of(sample_id: str) -> int:
     """A simulated sample's variation, from its id ``sim/PPP-V``."""
     if not str(sample_id).startswith("sim/"):
         raise ValueError(f"sample {sample_id!r} is not from our simulator: only simulated episodes can be executed")
@@ -231,7 +199,7 @@ def _nrmse(pred: np.ndarray, target: np.ndarray, length: int, joint_range: float
     return 100 * float(np.sqrt(np.mean(err ** 2))) / joint_range
 
 
-def _spread(n: int, limit: int | None) -> np.ndarray:
+def spread(n: int, limit: int | None) -> np.ndarray:
     """Indices 0..n-1, or ``limit`` of them evenly spread."""
     rows = np.arange(n)
     if limit is not None and limit < n:
@@ -239,15 +207,15 @@ def _spread(n: int, limit: int | None) -> np.ndarray:
     return rows
 
 
-def _execute_episode(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, episodes: PGAEDataset,
-                     i: int, planned: np.ndarray, text: str, joint_range: float, *,
-                     language: torch.Tensor | None = None, closed: bool = True,
-                     config: DatasetConfig | None = None, tracking: bool = True) -> dict:
+def execute_episode(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, episodes: PGAEDataset,
+                    i: int, planned: np.ndarray, text: str, joint_range: float, *,
+                    language: torch.Tensor | None = None, closed: bool = True,
+                    config: DatasetConfig | None = None, tracking: bool = True) -> dict:
     """Episode ``i`` of ``episodes`` executed open loop (``planned`` joints, (T, 5)) and closed loop: a table row.
 
     ``text`` is what the model was told; ``language`` (1, D), if given, its features (see :func:`closed_loop`).
     """
-    pattern, variation, length = int(episodes.pattern[i]), _variation(episodes.ids[i]), int(episodes.lengths[i])
+    pattern, variation, length = int(episodes.pattern[i]), variation_of(episodes.ids[i]), int(episodes.lengths[i])
     pat, recorded = Pattern.from_number(pattern), episodes.joints[i]
     row = {"id": episodes.ids[i], "pattern": pattern, "variation": variation, "action": pat.action,
            "side": pat.side, "speed": pat.speed, "description": text}
@@ -279,100 +247,10 @@ def compare(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data:
     pred = predict(model, subset, normaliser, "execute")          # open loop: recorded vision at every step
     joint_range = data.joint_range()
     return pd.DataFrame([
-        _execute_episode(model, cae, normaliser, subset, i, pred.joints[i],
+        execute_episode(model, cae, normaliser, subset, i, pred.joints[i],
                          description_text(subset.descriptions[i, i % 8]), joint_range,
                          config=config, tracking=tracking)
-        for i in tqdm(_spread(len(subset), limit), desc="open vs closed loop", unit="ep", disable=not progress)])
-
-
-# --------------------------------------------------------------------------- free-form instructions
-@torch.no_grad()
-def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
-    """Instructions -> the language encoder's features under ``execute``, (B, D), for ``language=``.
-
-    PGAE-BERT's pretrained encoder reads any text, after the signal phrase
-    (``input_text("execute", text)``, as in training). PGAE's LSTM reads only
-    its vocabulary: every text must be a description (action colour speed),
-    else a :class:`~pgae_lite.language.LanguageError` names the unknown words.
-    """
-    encoder = model.language_encoder
-    if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
-        return encoder.encode_texts([input_text("execute", t) for t in texts])
-    for t in texts:
-        try:
-            parse_description(t)
-        except LanguageError as e:
-            raise LanguageError(f"PGAE's LSTM language encoder reads only its vocabulary, in the order "
-                                f"action colour speed (PGAE-BERT reads free text): {e}") from e
-    device = next(model.parameters()).device
-    tokens = torch.tensor([[SIGNAL_TOKEN + signal_index("execute"), *(WORD_INDEX[w] for w in tokenize(t)), EOS]
-                           for t in texts], device=device)                                   # (B, 5)
-    return encoder(tokens, torch.full((len(texts),), 5, device=device))
-
-
-@torch.no_grad()
-def paper_execute(model: PGAE, episodes: PGAEDataset, normaliser: Normaliser, language: torch.Tensor,
-                  batch_size: int = 256) -> np.ndarray:
-    """The paper's execute (open loop: the recorded vision at every step) with language features (N, D).
-
-    :func:`~pgae_lite.evaluate.predict`'s ``execute`` with ``language`` in place of
-    the descriptions: joints (N, T, 5) in data units, step 0 = the start joints,
-    NaN past each episode's length.
-    """
-    model.eval()
-    device = next(model.parameters()).device
-    tensors, out = normaliser.tensors(episodes, device), []
-    for s in range(0, len(episodes), batch_size):
-        index = torch.arange(s, min(len(episodes), s + batch_size))
-        batch = make_batch(tensors, index, signal_ids("execute", len(index)), torch.zeros_like(index))
-        joints = model(batch, language=language[s:s + len(index)].to(device))["joints"]   # (B, T-1, 5)
-        out.append(normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], joints], 1)).cpu().numpy())
-    return np.where(episodes.mask[..., None], np.concatenate(out), np.nan).astype(np.float32)
-
-
-def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
-    """The paraphrase an episode is given: of its pattern's meaning, number ``variation`` mod how many there are.
-
-    With the 3 paraphrases per test instruction and 6 variations, each is used twice.
-    None: no paraphrase has that meaning.
-    """
-    pat = Pattern.from_number(pattern)
-    mine = [p for p in paraphrases if p.meaning == (pat.action, pat.colour, pat.speed)]
-    return mine[variation % len(mine)] if mine else None
-
-
-def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
-                        paraphrases: list[Paraphrase] | None = None, split: str = "test", *,
-                        limit: int | None = None, closed: bool = True, config: DatasetConfig | None = None,
-                        tracking: bool = True, progress: bool = True) -> pd.DataFrame:
-    """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
-
-    Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
-    :func:`~pgae_lite.paraphrases.load_paraphrases`) is told one
-    (:func:`paraphrase_of`), encoded by :func:`instruction_features`: PGAE-BERT
-    reads it, PGAE's LSTM raises a LanguageError naming the unknown words before
-    anything runs. Then, as in :func:`compare`: the paper's execute
-    (:func:`paper_execute`) run in the simulator (``open_*`` columns) and, if
-    ``closed``, :func:`closed_loop` (``closed_*``). nRMSE (%) is against the
-    recorded joints of the episode, the intended action. ``limit``: that many
-    episodes, evenly spread.
-    """
-    paraphrases = load_paraphrases() if paraphrases is None else paraphrases
-    subset = data.split(split)
-    told = [paraphrase_of(int(p), _variation(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
-    rows = np.flatnonzero([t is not None for t in told])
-    if not len(rows):
-        raise ValueError(f"no paraphrase has the meaning of any {split} episode")
-    rows = rows[_spread(len(rows), limit)]
-    episodes, told = subset.subset(rows), [told[i] for i in rows]
-    language = instruction_features(model, [t.text for t in told])          # (N, D)
-    planned = paper_execute(model, episodes, normaliser, language)
-    joint_range = data.joint_range()
-    return pd.DataFrame([
-        {**_execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
-                            language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
-         "meaning": " ".join(told[k].meaning)}
-        for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
+        for i in tqdm(spread(len(subset), limit), desc="open vs closed loop", unit="ep", disable=not progress)])
 
 
 def success_summary(table: pd.DataFrame) -> pd.DataFrame:
@@ -393,10 +271,10 @@ def pattern_for(description: str, arrangement: int) -> int:
     if colour not in (left, right):
         raise ValueError(f"there is no {colour} cube in arrangement {arrangement} ({left} left, {right} right)")
     side = "L" if colour == left else "R"
-    return 72 * ("slowly", "fast").index(speed) + 6 * arrangement + ACTION_SIDES.index((action, side))
+    return pattern_number(("slowly", "fast").index(speed), arrangement, ACTION_SIDES.index((action, side)))
 
 
-def animate(rollout: Rollout, every: int = 2, fps: float = 10.0, size: float = 2.8, dpi: int = 72):
+def animate(rollout: Execution, every: int = 2, fps: float = 10.0, size: float = 2.8, dpi: int = 72):
     """The rollout seen from NICO's eye, with its measured joints: a matplotlib animation.
 
     Show it in a notebook with ``IPython.display.HTML(animate(rollout).to_jshtml())``
@@ -409,6 +287,5 @@ def animate(rollout: Rollout, every: int = 2, fps: float = 10.0, size: float = 2
                           size=size, dpi=dpi, title=f"{rollout.description}: {verdict}")
 
 
-__all__ = ["Rollout", "closed_loop", "open_loop", "compare", "success_summary", "execute_batch", "words_of",
-           "pattern_for", "animate", "POSITION_GAIN", "instruction_features", "paper_execute", "paraphrase_of",
-           "execute_paraphrases"]
+__all__ = ["closed_loop", "open_loop", "compare", "success_summary", "execute_batch", "words_of", "pattern_for",
+           "animate", "execute_episode", "variation_of", "spread", "POSITION_GAIN"]

@@ -24,6 +24,7 @@ from dataclasses import asdict, dataclass, field, replace
 from .cae import CAEConfig
 from .data import check_vision_scaling
 from .language import SIGNALS
+from .patterns import pattern_number
 from .signals import SIGNAL_PROBS
 from .simdata import DatasetConfig
 
@@ -133,7 +134,7 @@ class ChapterSettings:
 BOOK_CAE = CAEConfig("book", batch_size=16, iterations=1000, frame_stride=10)
 #: Two arrangements (0: red+blue, 7: cyan+yellow), every action at both speeds;
 #: 10 of these 24 patterns are test patterns.
-SMOKE_PATTERNS = tuple(sorted(72 * s + 6 * a + i for s in (0, 1) for a in (0, 7) for i in range(6)))
+SMOKE_PATTERNS = tuple(sorted(pattern_number(s, a, i) for s in (0, 1) for a in (0, 7) for i in range(6)))
 
 
 @dataclass

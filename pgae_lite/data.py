@@ -1,12 +1,13 @@
-"""Datasets: one type for the authors' recordings and for our simulator's.
+"""Datasets: one type for the authors' recordings and for our simulator's, and their normalisation.
 
 Paper, Sec. 4 (Dataset). A sample is one recording of one of 144 patterns
-(12 cube arrangements x 12 actions): per time step 5 joint angles and 30
-visual features (10 per colour channel), for NICO's own view and for the
-opposite agent's; slow actions last 100 steps, fast ones 50, padded to 100
-with a mask. Each sample carries the 8 equivalent descriptions of its action.
+(12 cube arrangements x 12 actions, :mod:`pgae_lite.patterns`): per time step
+5 joint angles and 30 visual features (10 per colour channel), for NICO's own
+view and for the opposite agent's; slow actions last 100 steps, fast ones 50,
+padded to 100 with a mask. Each sample carries the 8 equivalent descriptions
+of its action.
 
-:func:`load_original` reads the authors' ``target/`` tree;
+:func:`pgae_lite.original.load_original` reads the authors' ``target/`` tree;
 :class:`Normaliser` maps every modality to [-1, 1] with statistics from the
 training split only.
 """
@@ -19,12 +20,16 @@ from typing import Iterable
 import numpy as np
 import torch
 
-from .language import VOCABULARY, WORD_INDEX, equivalent_descriptions
+from .language import VOCABULARY
+from .patterns import MAX_STEPS, Pattern
 from .utils import atomic_write
 
-MAX_STEPS = 100
 JOINT_DIM = 5
 VISION_DIM = 30
+
+
+class DataFormatError(ValueError):
+    """The authors' data folder (:mod:`pgae_lite.original`) or a dataset file is missing or malformed."""
 
 
 _ARRAYS = ("joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern",
@@ -222,167 +227,6 @@ class Normaliser:
         return cls(*(tuple(float(x) for x in state[k]) for k in ("joints", "vision", "vision_opposite")), white)
 
 
-# --------------------------------------------------------------------------- the 144 patterns
-#: The 12 cube arrangements (left+right), in the order of the authors' data.
-ARRANGEMENTS: tuple[tuple[str, str], ...] = (
-    ("red", "blue"), ("green", "red"), ("blue", "green"), ("blue", "red"), ("red", "green"),
-    ("green", "blue"), ("yellow", "violet"), ("cyan", "yellow"), ("violet", "cyan"),
-    ("violet", "yellow"), ("yellow", "cyan"), ("cyan", "violet"))
-#: Action order within an arrangement: (action, cube side).
-ACTION_SIDES: tuple[tuple[str, str], ...] = (
-    ("push", "L"), ("pull", "L"), ("slide", "L"), ("push", "R"), ("pull", "R"), ("slide", "R"))
-#: The 36 test patterns of the paper's split (the authors' actions.txt): every word
-#: and action type appears in test, but not these combinations of description,
-#: action and arrangement.
-TEST_PATTERNS: frozenset[int] = frozenset((
-    2, 6, 9, 14, 17, 25, 31, 33, 34, 38, 42, 45, 50, 53, 61, 67, 69, 70, 74, 76, 77, 78, 79, 80,
-    81, 84, 94, 110, 112, 113, 114, 115, 116, 117, 120, 130))
-
-
-@dataclass(frozen=True)
-class Pattern:
-    """One of the 144 patterns: pattern = 72·speed + 6·arrangement + action."""
-
-    number: int
-    action: str        # push | pull | slide
-    side: str          # L | R: which cube, from NICO's point of view
-    speed: str         # slowly | fast
-    left: str          # colour of the left cube
-    right: str         # colour of the right cube
-
-    @classmethod
-    def from_number(cls, number: int) -> "Pattern":
-        if not 0 <= number < 144:
-            raise ValueError(f"pattern number {number} out of range; patterns are 0-143")
-        speed, rest = divmod(number, 72)
-        arrangement, action = divmod(rest, 6)
-        act, side = ACTION_SIDES[action]
-        left, right = ARRANGEMENTS[arrangement]
-        return cls(number, act, side, ("slowly", "fast")[speed], left, right)
-
-    @property
-    def colour(self) -> str:
-        """Colour of the manipulated cube."""
-        return self.left if self.side == "L" else self.right
-
-    @property
-    def is_test(self) -> bool:
-        return self.number in TEST_PATTERNS
-
-    @property
-    def steps(self) -> int:
-        """Length of a recording: 100 steps slowly, 50 fast."""
-        return MAX_STEPS if self.speed == "slowly" else MAX_STEPS // 2
-
-    @property
-    def code(self) -> str:
-        """The authors' label, e.g. ``PUSH-L-SLOW``."""
-        return f"{self.action.upper()}-{self.side}-{'SLOW' if self.speed == 'slowly' else 'FAST'}"
-
-    def descriptions(self) -> np.ndarray:
-        """Word indices of the 8 equivalent descriptions, (8, 3)."""
-        alts = equivalent_descriptions(self.action, self.colour, self.speed)
-        return np.array([[WORD_INDEX[w] for w in alt] for alt in alts])
-
-
-# --------------------------------------------------------------------------- authors' data
-class DataFormatError(ValueError):
-    """The authors' data folder is missing or not in the expected format."""
-
-
-_SUBTREES = ("behavior", "vision", "vision_opp", "language")
-
-
-def _read_matrix(path: Path, width: int) -> np.ndarray:
-    if not path.is_file():
-        raise DataFormatError(f"missing file {path}: every sample needs the same file name in all sub-folders")
-    try:
-        values = np.array(path.read_text().split(), dtype=np.float32)
-    except ValueError as e:
-        raise DataFormatError(f"{path}: expected rows of {width} numbers ({e})") from None
-    if values.size == 0 or values.size % width:
-        raise DataFormatError(f"{path}: expected rows of {width} numbers, found {values.size} numbers")
-    return values.reshape(-1, width)
-
-
-def load_original(path: str | Path) -> PGAEDataset:
-    """Read the authors' dataset (the folder holding ``target/`` and ``actions.txt``).
-
-    Raises :class:`DataFormatError` naming what was expected when the folder,
-    a sub-tree or a file is missing or malformed.
-    """
-    root = Path(path).expanduser()
-    if (root / "target").is_dir():
-        target = root / "target"
-    elif root.name == "target" and root.is_dir():
-        target, root = root, root.parent
-    else:
-        raise DataFormatError(
-            f"{root} is not the authors' PGAE data folder: expected a folder containing 'target/' "
-            f"with sub-folders {', '.join(s + '_train' for s in _SUBTREES)} (and *_test), and "
-            "'actions.txt' / 'arrangements.txt' beside it (public repository oo222bs/PGAE)")
-    for sub in _SUBTREES:
-        for split in ("train", "test"):
-            if not (target / f"{sub}_{split}").is_dir():
-                raise DataFormatError(f"missing folder {target / f'{sub}_{split}'}")
-    pattern_info = _read_patterns(root)
-
-    rows: dict[str, list] = {k: [] for k in (
-        "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
-        "ids", "action", "arrangement")}
-    for split in ("train", "test"):
-        for date_dir in sorted((target / f"behavior_{split}").iterdir()):
-            for f in sorted(date_dir.glob("target*.txt")):
-                rel = f"{date_dir.name}/{f.stem}"
-                joints = _read_matrix(f, 5)
-                n = len(joints)
-                vision = _read_matrix(target / f"vision_{split}" / f"{rel}.txt", 30)
-                opposite = _read_matrix(target / f"vision_opp_{split}" / f"{rel}.txt", 30)
-                lang = _read_matrix(target / f"language_{split}" / f"{rel}.txt", len(VOCABULARY))
-                if len(vision) != n or len(opposite) != n or not 0 < n <= MAX_STEPS:
-                    raise DataFormatError(
-                        f"{rel}: joints, vision and opposite vision must have the same number of steps "
-                        f"(<= {MAX_STEPS}); got {n}, {len(vision)}, {len(opposite)}")
-                if lang.shape[0] != 40:
-                    raise DataFormatError(f"{rel}: language file must have 40 one-hot rows (8 x 5), got {lang.shape[0]}")
-                words = lang.argmax(1).reshape(8, 5)[:, 1:4]  # (8 alternatives, 3 words)
-                pattern = int(f.stem.replace("target", ""))
-                if pattern not in pattern_info:
-                    raise DataFormatError(f"{rel}: pattern {pattern} not listed in actions.txt")
-                action, arrangement, split_name = pattern_info[pattern]
-                if split_name != split:
-                    raise DataFormatError(f"{rel}: actions.txt puts pattern {pattern} in {split_name}, found in {split}")
-                pad = ((0, MAX_STEPS - n), (0, 0))
-                rows["joints"].append(np.pad(joints, pad))
-                rows["vision"].append(np.pad(vision, pad))
-                rows["vision_opposite"].append(np.pad(opposite, pad))
-                rows["lengths"].append(n)
-                rows["descriptions"].append(words)
-                rows["pattern"].append(pattern)
-                rows["is_test"].append(split == "test")
-                rows["ids"].append(rel)
-                rows["action"].append(action)
-                rows["arrangement"].append(arrangement)
-    if not rows["ids"]:
-        raise DataFormatError(f"no samples found under {target}/behavior_train/DATE/target*.txt")
-    order = np.argsort(rows["ids"], kind="stable")  # by date, then pattern: a fixed order
-    arrays = {k: np.asarray(v)[order] for k, v in rows.items()}
-    return PGAEDataset(**arrays, source=f"original:{root}")
-
-
-def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:
-    actions_file, arrangements_file = root / "actions.txt", root / "arrangements.txt"
-    for f in (actions_file, arrangements_file):
-        if not f.is_file():
-            raise DataFormatError(f"missing {f} (one line per pattern, from the authors' repository)")
-    actions = [line.split() for line in actions_file.read_text().splitlines() if line.strip()]
-    arrangements = [line.strip() for line in arrangements_file.read_text().splitlines() if line.strip()]
-    if len(actions) != len(arrangements) or any(len(a) != 2 for a in actions):
-        raise DataFormatError(f"{actions_file} must have 'ACTION-CUBE-SPEED train|test' per line, "
-                              f"as many lines as {arrangements_file}")
-    return {i: (a[0], arr, a[1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
-
-
 def from_recordings(recordings: Iterable[tuple[Pattern, str, np.ndarray, np.ndarray, np.ndarray]],
                     source: str) -> PGAEDataset:
     """A :class:`PGAEDataset` from recordings ``(pattern, id, joints (n, 5), vision (n, 30), opposite (n, 30))``.
@@ -414,5 +258,5 @@ def description_text(indices: np.ndarray) -> str:
     return " ".join(VOCABULARY[int(i)] for i in indices)
 
 
-__all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "load_original", "from_recordings", "description_text",
-           "MAX_STEPS", "JOINT_DIM", "VISION_DIM", "Pattern", "ARRANGEMENTS", "TEST_PATTERNS"]
+__all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "from_recordings", "description_text", "JOINT_DIM",
+           "VISION_DIM"]

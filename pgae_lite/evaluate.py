@@ -52,10 +52,14 @@ class Predictions:
 @torch.no_grad()
 def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
             opposite: bool = False, batch_size: int = 256,
-            tensors: dict[str, torch.Tensor] | None = None) -> Predictions:
+            tensors: dict[str, torch.Tensor] | None = None, language: torch.Tensor | None = None) -> Predictions:
     """Run ``model`` on every sample of ``data`` with one signal (decoders free-running).
 
     ``tensors``: ``normaliser.tensors(data, device)`` when the caller has them already.
+    ``language`` (N, D): precomputed language features, one row per sample, in place of
+    the language encoder's (``model(batch, language=...)``), e.g. free text through
+    :func:`pgae_lite.instructions.instruction_features`: with ``"execute"`` the paper's
+    execute (open loop: the recorded vision at every step) of those instructions.
     """
     signal = normalise_signal(signal)
     model.eval()
@@ -67,7 +71,10 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
         index = torch.arange(s, min(n, s + batch_size))
         batch = make_batch(tensors, index, signal_ids(signal, len(index)), index % 8,
                            torch.full((len(index),), opposite))
-        out = model(batch)                                   # decoders free-running, greedy words
+        if language is None:
+            out = model(batch)                               # decoders free-running, greedy words
+        else:
+            out = model(batch, language=language[s:s + len(index)].to(device))
         texts += [decode(row) for row in out["logits"].argmax(-1).cpu()]
         pred = torch.cat([batch.start_joints[:, None], out["joints"]], 1)        # (B, T, 5)
         target = torch.cat([batch.start_joints[:, None], batch.joint_target], 1)

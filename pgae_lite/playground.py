@@ -35,15 +35,18 @@ import numpy as np
 import torch
 from matplotlib.figure import Figure
 
+from . import patterns
 from .cae import ChannelSeparatedCAE
-from .closedloop import Rollout, closed_loop, open_loop, pattern_for
+from .closedloop import closed_loop, open_loop, pattern_for
 from .config import PROFILES
-from .data import ACTION_SIDES, ARRANGEMENTS, Normaliser, Pattern, PGAEDataset, description_text
+from .data import Normaliser, PGAEDataset, description_text
 from .language import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
     parse_description, tokenize
+from .patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
 from .pgae import PGAE
 from .pretrained import input_text
 from .signals import LANG_IN, LANG_OUT, make_batch, signal_ids
+from .sim.record import Execution
 from .simdata import DatasetConfig
 from .viz import animate_frames, plot_joints
 
@@ -72,7 +75,7 @@ def action_label(action: int) -> str:
 
 def pattern_number(arrangement: int, action: int) -> int:
     """The pattern (0-143) of action ``action`` (0-11) in arrangement ``arrangement`` (0-11)."""
-    return 72 * (action // 6) + 6 * arrangement + action % 6
+    return patterns.pattern_number(action // 6, arrangement, action % 6)
 
 
 def simulator_config(data: PGAEDataset) -> DatasetConfig:
@@ -86,7 +89,7 @@ def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[i
     rows = np.flatnonzero(data.pattern == pattern)
     if variation >= len(rows):
         p = Pattern.from_number(pattern)
-        have = sorted({arrangement_label(int(q) % 72 // 6) for q in data.pattern})
+        have = sorted({arrangement_label(pattern_parts(int(q))[1]) for q in data.pattern})
         what = f"pattern {pattern} ({p.action} {p.colour} {p.speed}, {p.left} left, {p.right} right)"
         raise ValueError(f"this dataset has no recording of {what}; its arrangements are: {'; '.join(have)}"
                          if not len(rows) else f"this dataset has {len(rows)} recording(s) of {what}, "
@@ -111,7 +114,7 @@ class PlayResult:
     target: np.ndarray        # (length, 5) what the signal asks for (see TARGETS)
     nrmse: float              # % of the dataset's joint range, over steps 1..length-1
     gate: np.ndarray          # (hidden,) GMU gate z: 1 lets the action through, 0 the language
-    rollout: Rollout | None   # the simulator's execution of ``joints`` (None: not simulated)
+    rollout: Execution | None  # the simulator's execution of ``joints`` (None: not simulated)
     loop: str | None = None   # "open", "closed" or None: how the simulator ran the joints
 
     def summary(self) -> str:
@@ -263,7 +266,7 @@ class Playground:
         self.models, self.cae, self.data, self.config, self.every = dict(models), cae, data, config, every
         self.result: PlayResult | None = None
         self.message = ""
-        arrangements = sorted({int(p) % 72 // 6 for p in data.pattern})   # those the dataset recorded
+        arrangements = sorted({pattern_parts(int(p))[1] for p in data.pattern})   # those the dataset recorded
         variations = int(np.bincount(data.pattern).max())
         self.model = w.Dropdown(options=list(self.models), description="model")
         self.signal = w.ToggleButtons(options=PLAY_SIGNALS, value=normalise_signal(signal), description="signal")

@@ -128,7 +128,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
     per row are trained, with seeds ``seed, seed + 1, ...``.
     """
-    from .data import load_original
+    from .original import load_original
 
     rows = parse_rows(rows)
     if seeds < 1:

@@ -39,7 +39,8 @@ from typing import Callable, Iterator
 import numpy as np
 from tqdm.auto import tqdm
 
-from .data import PGAEDataset, Pattern, from_recordings
+from .data import PGAEDataset, from_recordings
+from .patterns import Pattern
 from .sim.record import Episode, SimConfig, record_episode
 from .utils import atomic_write, atomic_write_text, cache_dir, config_digest
 

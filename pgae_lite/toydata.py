@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .data import Pattern, PGAEDataset, from_recordings
+from .data import PGAEDataset, from_recordings
 from .language import COLOURS
+from .patterns import Pattern
 
 
 def _min_jerk(tau: np.ndarray) -> np.ndarray:

@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data import Normaliser, load_original
+from pgae_lite.data import Normaliser
+from pgae_lite.original import load_original
 from pgae_lite.toydata import toy_dataset
 
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"

@@ -8,11 +8,11 @@ import torch
 from pgae_lite.closedloop import (animate, closed_loop, compare, execute_batch, open_loop, pattern_for,
                                   success_summary, words_of)
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.data import ARRANGEMENTS, Pattern
 from pgae_lite.evaluate import predict
+from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_number
 from pgae_lite.pgae import ActionDecoder
 from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.sim import Simulation, execute_trajectory
+from pgae_lite.sim import Execution, Simulation, execute_trajectory
 from pgae_lite.simdata import load_episode
 from pgae_lite.train import train
 
@@ -78,6 +78,8 @@ def test_closed_loop_starts_like_the_recording_and_is_deterministic(smoke):
     sim.reset(PATTERN, 0, SMOKE.base_seed, render=False)
     replay = sim.run(run.targets, render=False)
     assert replay.passed == run.passed and np.array_equal(replay.displacement, run.displacement)
+    assert isinstance(run, Execution) and isinstance(replay, Execution)               # one type for both
+    assert (replay.pattern, replay.variation) == (run.pattern, run.variation) == (PATTERN, 0)
 
 
 def test_executing_the_recorded_joints_passes_the_check(smoke_episodes):
@@ -107,6 +109,6 @@ def test_pattern_for_finds_every_pattern_from_its_description():
         pat = Pattern.from_number(number)
         arrangement = ARRANGEMENTS.index((pat.left, pat.right))
         assert pattern_for(f"{pat.action} {pat.colour} {pat.speed}", arrangement) == number
-    assert pattern_for("move-sideways azure quickly", 0) == 72 + 5      # red+blue: blue is the right cube
+    assert pattern_for("move-sideways azure quickly", 0) == pattern_number(1, 0, 5)   # red+blue: blue is the right cube
     with pytest.raises(ValueError, match="no yellow cube"):
         pattern_for("push yellow slowly", 0)

@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data import Normaliser, Pattern
+from pgae_lite.data import Normaliser
 from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.language import TEST_SIGNALS, WORD_INDEX
+from pgae_lite.patterns import Pattern
 from pgae_lite.config import ModelConfig
 from pgae_lite.pgae import PGAE
 

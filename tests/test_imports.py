@@ -93,6 +93,7 @@ def test_the_graph_is_read():
     assert "pgae_lite.train" in GRAPH["pgae_lite.pipeline"]           # a function-level import counts
     assert "pgae_lite.language" in GRAPH["pgae_lite.sim.actions"]      # from ..language
     assert "pgae_lite.sim" in GRAPH["pgae_lite.closedloop"]            # a subpackage runs its __init__
+    assert "pgae_lite.patterns" in GRAPH["pgae_lite.playground"]       # from . import patterns
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
 
 
@@ -110,9 +111,34 @@ def test_config_imports_nothing_that_imports_it():
     assert "pgae_lite.reproduce" not in reachable("pgae_lite.pipeline")
 
 
+#: What the rest of the package builds on: none of these may import a module above it.
+HIGH = {"pgae_lite.train", "pgae_lite.evaluate", "pgae_lite.pipeline", "pgae_lite.reproduce", "pgae_lite.closedloop",
+        "pgae_lite.instructions", "pgae_lite.playground", "pgae_lite.viz", "pgae_lite.exercises"}
+
+
+def test_no_backwards_imports():
+    """Low-level modules never import high-level ones (a split module must not reach back up)."""
+    assert reachable("pgae_lite.patterns") == {"pgae_lite.language"}          # the numbering needs only the words
+    assert reachable("pgae_lite.data") <= {"pgae_lite.language", "pgae_lite.patterns", "pgae_lite.utils"}
+    for name in ("pgae_lite.sim.record", "pgae_lite.sim"):
+        assert "pgae_lite.data" not in reachable(name), name                  # the simulator needs the patterns only
+    low = [n for n in MODULES if n.startswith("pgae_lite.sim") or n in (
+        "pgae_lite.language", "pgae_lite.patterns", "pgae_lite.data", "pgae_lite.original", "pgae_lite.layers",
+        "pgae_lite.signals", "pgae_lite.cae", "pgae_lite.simdata", "pgae_lite.config", "pgae_lite.pgae")]
+    for name in low:
+        assert not {h for h in reachable(name) for top in HIGH if h == top or h.startswith(top + ".")}, name
+    assert "pgae_lite.instructions" not in reachable("pgae_lite.closedloop")
+    assert not reachable("pgae_lite.viz") & {"pgae_lite.train", "pgae_lite.evaluate", "pgae_lite.closedloop"}
+
+
+def test_every_module_is_at_most_350_lines():
+    long = {name: n for name, path in MODULES.items() if (n := len(path.read_text(encoding="utf-8").splitlines())) > 350}
+    assert not long, f"split these modules (at most 350 lines each): {long}"
+
+
 def test_only_config_reads_the_profile_variable():
     """Every module asks config.profile_name(); only config.py looks the variable up in os.environ."""
-    files = sorted(PACKAGE.glob("*.py")) + sorted(PACKAGE.glob("sim/*.py"))
+    files = sorted(PACKAGE.rglob("*.py"))
     reads = re.compile(r"(environ\.get\(|environ\[|getenv\()\s*(PROFILE_ENV|[\"']PGAE_LITE_PROFILE)")
     readers = [p.relative_to(PACKAGE).as_posix() for p in files if reads.search(p.read_text(encoding="utf-8"))]
     assert readers == ["config.py"], f"only config.py may read PGAE_LITE_PROFILE from the environment; found {readers}"

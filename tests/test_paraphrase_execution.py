@@ -11,13 +11,14 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.closedloop import (closed_loop, execute_paraphrases, instruction_features, paper_execute,
-                                  paraphrase_of, success_summary)
+from pgae_lite.closedloop import closed_loop, success_summary
 from pgae_lite.config import get_profile
-from pgae_lite.data import Pattern, description_text
+from pgae_lite.data import description_text
 from pgae_lite.evaluate import predict
+from pgae_lite.instructions import execute_paraphrases, instruction_features, paraphrase_of
 from pgae_lite.language import LanguageError
 from pgae_lite.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.patterns import Pattern
 from pgae_lite.pipeline import simulated_dataset, trained_cae
 from pgae_lite.train import train
 
@@ -69,7 +70,7 @@ def test_pgae_bert_executes_a_paraphrase_in_every_test_episode(smoke):
     assert run.passed == first.closed_passed and run.check.reason == first.closed_reason
 
 
-def test_instruction_features_and_paper_execute_match_the_package(smoke):
+def test_instruction_features_and_predict_with_language_match_the_package(smoke):
     data, _, bert, lstm = smoke
     # PGAE-BERT reads "execute push red slowly" as free text exactly as training read the tokens.
     texts = ["push red slowly", "pull scarlet quickly"]
@@ -81,7 +82,8 @@ def test_instruction_features_and_paper_execute_match_the_package(smoke):
     # Written as training wrote them for the transformer ("move up", not "move-up"); the LSTM reads both.
     said = [description_text(test.descriptions[i, i % 8]).replace("-", " ") for i in range(len(test))]
     for trained in (lstm, bert):
-        joints = paper_execute(trained.model, test, trained.normaliser, instruction_features(trained.model, said))
+        told = instruction_features(trained.model, said)
+        joints = predict(trained.model, test, trained.normaliser, "execute", language=told).joints
         expected = predict(trained.model, test, trained.normaliser, "execute").joints
         assert np.allclose(joints, expected, atol=1e-5, equal_nan=True), trained.profile.model.language_encoder
 

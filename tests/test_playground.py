@@ -15,11 +15,13 @@ import pytest
 import torch
 
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
-from pgae_lite.closedloop import instruction_features, paper_execute, pattern_for
-from pgae_lite.data import ARRANGEMENTS, Normaliser, Pattern
+from pgae_lite.closedloop import pattern_for
+from pgae_lite.data import Normaliser
 from pgae_lite.evaluate import predict
+from pgae_lite.instructions import instruction_features
 from pgae_lite.language import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
+from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_parts
 from pgae_lite.pgae import PGAE
 from pgae_lite.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
@@ -122,7 +124,7 @@ def test_bad_text_is_a_friendly_error(tiny, toy, signal, text, error, message):
 
 def test_a_pattern_the_dataset_lacks_and_a_bad_loop_are_friendly_errors(tiny, toy):
     model, normaliser = tiny
-    only = toy.subset(np.isin(toy.pattern // 6 % 12, [0, 7]))                # two arrangements, as in smoke
+    only = toy.subset(np.isin(pattern_parts(toy.pattern)[1], [0, 7]))                # two arrangements, as in smoke
     with pytest.raises(ValueError, match="no recording of pattern 18 .*arrangements are: cyan left, yellow right; red"):
         play(model, None, normaliser, only, "execute", 3, 0, loop=None)
     with pytest.raises(ValueError, match="1 recording.*no variation 2"):
@@ -174,8 +176,8 @@ def test_pgae_bert_reads_free_text(toy):
     r = play(model, None, normaliser, toy, "execute", 0, 3, text, loop=None)   # 0: red left, blue right; 3: push right
     assert r.pattern == 3 and r.told == f"execute {text}"
     row = _row(toy, 3)
-    paper = paper_execute(model, toy.subset([row]), normaliser, instruction_features(model, [text]))
-    np.testing.assert_allclose(r.joints, paper[0, :len(r.joints)], atol=1e-5)
+    paper = predict(model, toy.subset([row]), normaliser, "execute", language=instruction_features(model, [text]))
+    np.testing.assert_allclose(r.joints, paper.joints[0, :len(r.joints)], atol=1e-5)
     plain = play(model, None, normaliser, toy, "execute", 0, 3, loop=None)
     assert not np.allclose(r.joints, plain.joints)
     with pytest.raises(LanguageError, match="'describe' reads no words"):
@@ -207,7 +209,7 @@ def test_widget_offers_the_datasets_choices(tiny, toy):
     ui = Playground({"PGAE": tiny}, None, toy)
     assert ui.signal.options == PLAY_SIGNALS and len(ui.action.options) == 12
     assert [v for _, v in ui.arrangement.options] == list(range(12)) and list(ui.variation.options) == [0]
-    only = toy.subset(np.isin(toy.pattern // 6 % 12, [0, 7]))
+    only = toy.subset(np.isin(pattern_parts(toy.pattern)[1], [0, 7]))
     assert [v for _, v in Playground({"PGAE": tiny}, None, only).arrangement.options] == [0, 7]
     assert "application/vnd.jupyter.widget-view+json" in ui._repr_mimebundle_()
     first = Playground({"PGAE": tiny}, None, toy, signal="Repeat Action", arrangement=ARRANGEMENT, action=ACTION)

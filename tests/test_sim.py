@@ -12,13 +12,13 @@ import pybullet as p
 import pytest
 from pybullet_utils import bullet_client
 
-from pgae_lite.data import ACTION_SIDES, ARRANGEMENTS, Pattern
 from pgae_lite.language import COLOURS
+from pgae_lite.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
 from pgae_lite.sim import (CUBE_RGBA, HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot, Scene, SceneLayout, SimConfig,
                            Simulation, check_action, episode_seed, execute_trajectory, record_episode)
 from pgae_lite.sim.robot import REST_POSE
 
-FAST = 72          # pattern numbers from 72 on are the fast (50-step) ones
+FAST = pattern_number(1, 0, 0)   # pattern numbers from 72 on are the fast (50-step) ones
 
 
 @pytest.fixture(scope="module")
@@ -122,7 +122,7 @@ def test_backdrop_render_equals_a_full_render(sim):
 
 
 # --------------------------------------------------------------------------- the 12 actions
-@pytest.mark.parametrize("number", [s * 72 + a for s in (0, 1) for a in range(6)],
+@pytest.mark.parametrize("number", [pattern_number(s, 0, a) for s in (0, 1) for a in range(6)],
                          ids=lambda n: Pattern.from_number(n).code)
 def test_each_action_moves_the_named_cube_the_named_way(sim, number):
     pattern = Pattern.from_number(number)
@@ -135,11 +135,11 @@ def test_each_action_moves_the_named_cube_the_named_way(sim, number):
     assert sign * moved[axis] > 0.04, ex.displacement
     assert abs(moved[1 - axis]) < 0.5 * abs(moved[axis])
     assert np.linalg.norm(other) < 0.01
-    assert ex.passed and ex.joints.shape == (pattern.steps, 5)
+    assert ex.passed and ex.measured.shape == (pattern.steps, 5)
     assert np.abs(ex.tracking_error).max() < 0.5           # no arm jammed against the table
 
 
-def test_arrangements_and_actions_follow_the_data_module():
+def test_arrangements_and_actions_follow_the_patterns_module():
     assert Pattern.from_number(0).left == ARRANGEMENTS[0][0] and ACTION_SIDES[2] == ("slide", "L")
 
 
@@ -179,6 +179,9 @@ def test_execute_trajectory_checks_any_trajectory(sim, episode):
     plan = sim.plan()
     ex = execute_trajectory(plan.joints, FAST, 0)
     assert ex.passed and ex.frames.shape == (50, 120, 160, 3)
+    assert (ex.pattern, ex.variation, ex.description) == (FAST, 0, "")
+    assert np.array_equal(ex.joints, plan.joints) and np.array_equal(ex.targets, plan.joints)   # asked = sent
+    np.testing.assert_array_equal(ex.tracking_error, ex.measured - ex.targets)
     with pytest.raises(ValueError, match=r"shape \(T, 5\)"):
         execute_trajectory(np.zeros((50, 4)), FAST)
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from pgae_lite.config import SMOKE_PATTERNS
-from pgae_lite.data import PGAEDataset, Pattern
+from pgae_lite.data import PGAEDataset
+from pgae_lite.patterns import Pattern
 from pgae_lite.simdata import (CorruptEpisodeError, DatasetConfig, episode_folder, generate, load_episode,
                                load_episode_file)
 

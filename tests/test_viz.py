@@ -102,7 +102,7 @@ def test_animate_frames_plays_every_nth_step_and_embeds_offline():
 
 
 def test_plot_patterns_labels_all_144_and_outlines_test_patterns():
-    from pgae_lite.data import TEST_PATTERNS
+    from pgae_lite.patterns import TEST_PATTERNS
     from pgae_lite.viz import plot_patterns
 
     fig = plot_patterns(marked=(0, 1, 2))

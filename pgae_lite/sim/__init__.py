@@ -7,7 +7,7 @@ student can read, one concept per module:
 - ``robot``    the NICO-like robot (URDF generated in Python), joints, IK
 - ``scene``    table, cubes, both robots, NICO's eye camera and renderer
 - ``actions``  push / pull / slide as min-jerk hand paths through IK; the check
-- ``record``   episodes: both views, seeds and retries, determinism; ``Simulation``
+- ``record``   episodes: both views, seeds and retries, determinism; ``Simulation``, ``Execution``
 
 Quick start::
 

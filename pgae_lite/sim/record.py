@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..data import Pattern
+from ..patterns import NUMBERING, Pattern
 from .actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
                       check_action, plan_action, sample_variation, world_direction)
 from .robot import JOINT_LIMITS, JOINT_NAMES, Robot
@@ -75,7 +75,7 @@ class SimConfig:
 class Episode:
     """One recording of one pattern (see the module docstring for who does what)."""
 
-    pattern: int                  # 0-143, pgae_lite.data.Pattern numbering
+    pattern: int                  # 0-143, pgae_lite.patterns numbering
     variation: int                # 0-5
     seed: int                     # the seed that produced this (valid) episode
     attempts: int                 # 1 if the first seed worked
@@ -89,13 +89,23 @@ class Episode:
 
 @dataclass
 class Execution:
-    """The outcome of driving one agent along a joint trajectory."""
+    """One execution in the simulator: what was asked, what the arm did, what the cubes did.
 
-    frames: np.ndarray | None     # (T, H, W, 3) uint8 from NICO's eye, None if not rendered
-    joints: np.ndarray            # (T, 5) measured joint angles (rad) after each step
-    targets: np.ndarray           # (T, 5) the joint targets given
+    The outcome of driving one agent along a joint trajectory: :meth:`Simulation.run`
+    (the recordings, :func:`execute_trajectory`) and the model's executions
+    (:func:`pgae_lite.closedloop.open_loop`, :func:`~pgae_lite.closedloop.closed_loop`).
+    """
+
+    pattern: int                  # the scene (and the action the check expects), 0-143
+    variation: int
+    frames: np.ndarray | None     # (T, H, W, 3) uint8 from NICO's eye after each step, None if not rendered
+    joints: np.ndarray            # (T, 5) joints asked for (our simulator's units: radians); for a model,
+                                  # step 0 = the start joints, then ĵ_1..ĵ_{T-1}
+    measured: np.ndarray          # (T, 5) measured joint angles (rad) after each step
+    targets: np.ndarray           # (T, 5) the joint targets given at each step (rad)
     displacement: np.ndarray      # (2, 3) left and right cube (m, world frame)
     check: ActionCheck            # the pattern's action, checked for the acting agent
+    description: str = ""         # the words given to the model ("" when none)
 
     @property
     def passed(self) -> bool:
@@ -104,7 +114,7 @@ class Execution:
     @property
     def tracking_error(self) -> np.ndarray:
         """Measured minus commanded joints (T, 5): large values mean the arm was blocked."""
-        return self.joints - self.targets
+        return self.measured - self.targets
 
 
 def episode_seed(pattern: int, variation: int, base_seed: int = 0, attempt: int = 0) -> int:
@@ -114,7 +124,7 @@ def episode_seed(pattern: int, variation: int, base_seed: int = 0, attempt: int 
 
 def _validate(pattern: int, variation: int, base_seed: int) -> Pattern:
     if not isinstance(pattern, (int, np.integer)) or not 0 <= pattern < 144:
-        raise ValueError(f"pattern must be an integer 0-143 (72 * speed + 6 * arrangement + action), "
+        raise ValueError(f"pattern must be an integer 0-143 ({NUMBERING}), "
                          f"got {pattern!r}")
     if not isinstance(variation, (int, np.integer)) or not 0 <= variation < 100:
         raise ValueError(f"variation must be an integer 0-99 (the dataset uses 0-5), got {variation!r}")
@@ -151,6 +161,7 @@ class Simulation:
         self.config = config
         self.scene: Scene | None = None
         self.pattern: Pattern | None = None
+        self.variation: int | None = None
 
     def reset(self, pattern: int, variation: int = 0, base_seed: int = 0, agent: str = "nico",
               render: bool = True) -> np.ndarray | None:
@@ -165,7 +176,7 @@ class Simulation:
                                image_size=(cfg.image_height, cfg.image_width))
         else:
             self.scene.rebuild(layout, agent)
-        self.pattern, self.agent = Pattern.from_number(int(pattern)), agent
+        self.pattern, self.variation, self.agent = Pattern.from_number(int(pattern)), int(variation), agent
         return self.scene.render() if render else None
 
     @property
@@ -226,8 +237,8 @@ class Simulation:
             measured.append(self.joints())
             if render:
                 frames.append(frame)
-        return Execution(np.stack(frames) if render else None, np.array(measured), targets,
-                         self.cube_displacement(), self.check())
+        return Execution(self.pattern.number, self.variation, np.stack(frames) if render else None, targets,
+                         np.array(measured), targets, self.cube_displacement(), self.check())
 
 
 @functools.lru_cache(maxsize=4)
@@ -277,7 +288,7 @@ def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig()
                     "failures": failures}
             log.debug("pattern %d variation %d: seed %d, max tracking error %.3f / %.3f rad (NICO / opposite)",
                       pattern, variation, seed, info["tracking_error"], info["tracking_error_opposite"])
-            return Episode(int(pattern), int(variation), seed, attempt + 1, me.joints.astype(np.float32),
+            return Episode(int(pattern), int(variation), seed, attempt + 1, me.measured.astype(np.float32),
                            me.frames, other.frames, me.displacement.astype(np.float32), True, info)
     raise RuntimeError(f"pattern {pattern} ({Pattern.from_number(int(pattern)).code}), variation {variation}: "
                        f"no valid episode in {config.max_attempts} attempts; last failures: "

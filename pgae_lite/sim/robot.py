@@ -29,7 +29,6 @@ after its axis in our zero pose, so that the arm has the paper's 5 joints.
 from __future__ import annotations
 
 import functools
-import hashlib
 import math
 import os
 import tempfile
@@ -39,7 +38,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
-from ..utils import atomic_write_text
+from ..utils import atomic_write_text, config_digest
 
 #: The 5 recorded joints of the left arm, from shoulder to wrist.
 JOINT_NAMES: tuple[str, ...] = ("l_shoulder_z", "l_shoulder_y", "l_arm_x", "l_elbow_y", "l_wrist_y")
@@ -161,7 +160,7 @@ def nico_urdf() -> str:
 def urdf_path() -> str:
     """Path of a file holding :func:`nico_urdf` (written once; named by its content's digest)."""
     text = nico_urdf()
-    path = os.path.join(tempfile.gettempdir(), f"nico_lite_{hashlib.sha1(text.encode()).hexdigest()[:12]}.urdf")
+    path = os.path.join(tempfile.gettempdir(), f"nico_lite_{config_digest(text)}.urdf")
     if not os.path.exists(path):
         atomic_write_text(path, text)          # parallel workers never see half a file
     return path

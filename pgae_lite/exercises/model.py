@@ -1,111 +1,37 @@
-"""Check functions for the book's exercises: your version against the package's.
+"""Checks of the model chapter's exercises: the LSTM step, the GMU or a replacement, the signals.
 
-Each check runs a student's code next to the reference on seeded random inputs and returns a
-:class:`CheckResult`: a short report (what matched; where and by how much it did not, with a hint
-tied to the paper's equation), truthy only when everything matched (``assert check_gmu(MyGMU)``).
-A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacement, the signals;
-Sec. 4: the vocabulary, and our simulator's cube colours.
+Paper, Sec. 3 (the peephole LSTM of the encoders and decoders, the GMU
+"Bottleneck", the signals and how often training draws each). Each check runs
+a student's code next to the reference on seeded random inputs and returns a
+:class:`~pgae_lite.exercises.result.CheckResult` that names a known mistake
+when one reproduces the student's outputs (chapter 04; ``check_bottleneck``
+also in chapter 05).
 """
 from __future__ import annotations
 
 import itertools
 import math
 import re
-from dataclasses import dataclass, field
 from functools import partial
-from typing import Any, Callable, Sequence
+from typing import Callable, Sequence
 
 import torch
 from torch import nn
 
-from .data import Normaliser
-from .language import COLOURS, SIGNALS, VOCABULARY, word_weights
-from .layers import GatedMultimodalUnit, PeepholeLSTMCell
-from .config import ModelConfig
-from .pgae import PGAE, count_parameters
-from .signals import SIGNAL_PROBS, make_batch, sample_signals
-from .toydata import toy_dataset
-from .train import pgae_loss
+from ..config import ModelConfig
+from ..data import Normaliser
+from ..language import SIGNALS, word_weights
+from ..layers import GatedMultimodalUnit, PeepholeLSTMCell
+from ..pgae import PGAE, count_parameters
+from ..signals import SIGNAL_PROBS, make_batch, sample_signals
+from ..toydata import toy_dataset
+from ..train import pgae_loss
+from .result import CheckResult, _build, _call, _compare, _diagnose, _pair, _shape
 
 LSTM_EQUATION = ("[i; j; f; o] = x W_x + h W_h + b, c_t = σ(f + 0.8 + p_f ⊙ c_{t-1}) ⊙ c_{t-1} "
                  "+ σ(i + p_i ⊙ c_{t-1}) ⊙ tanh(j), h_t = σ(o + p_o ⊙ c_t) ⊙ tanh(c_t)")
 GMU_EQUATION = ("A_h = tanh(W_A f_act + b), L_h = tanh(W_L f_lang + b), z = σ(W_z [f_act; f_lang] + b), "
                 "h = z*A_h + (1-z)*L_h")
-
-
-@dataclass(repr=False)
-class CheckResult:
-    """What a check found: truthy when everything matched; ``print`` it, or let Jupyter show it."""
-
-    name: str
-    passed: bool = True
-    lines: list[str] = field(default_factory=list)
-
-    def ok(self, text: str) -> CheckResult:
-        self.lines.append(f"  ✓ {text}")
-        return self
-
-    def fail(self, text: str, hint: str | None = None) -> CheckResult:
-        """Record a failure (and a hint); returns the result, so a check can ``return result.fail(...)``."""
-        self.passed = False
-        self.lines.append(f"  ✗ {text}" + (f"\n      hint: {hint}" if hint else ""))
-        return self
-
-    def note(self, text: str) -> CheckResult:
-        self.lines.append(f"  · {text}")
-        return self
-
-    def __bool__(self) -> bool:
-        return self.passed
-
-    def __str__(self) -> str:
-        return "\n".join([f"{self.name}: {'passed' if self.passed else 'not yet, see the ✗ lines'}", *self.lines])
-
-    __repr__ = __str__
-
-
-def _call(result: CheckResult, what: str, fn: Callable, *args: Any) -> Any:
-    """Run student code; an exception becomes a failure line, never a traceback."""
-    try:
-        return fn(*args)
-    except Exception as error:  # noqa: BLE001 - an error in student code is a finding
-        result.fail(f"{what} raised {type(error).__name__}: {error}")
-        return None
-
-
-def _shape(t: Any) -> str:
-    return f"shape {tuple(t.shape)}" if isinstance(t, torch.Tensor) else f"type {type(t).__name__}"
-
-
-def _pair(result: CheckResult, out: Any, names: str) -> bool:
-    if out is None or (isinstance(out, (tuple, list)) and len(out) == 2):
-        return out is not None
-    result.fail(f"it should return the pair ({names}); got {type(out).__name__}")
-    return False
-
-
-def _compare(result: CheckResult, name: str, got: Any, expected: torch.Tensor) -> bool:
-    """One output against the reference: type, shape, then values (where, and by how much)."""
-    if not isinstance(got, torch.Tensor) or got.shape != expected.shape:
-        result.fail(f"{name} has {_shape(got)}; expected a tensor of shape {tuple(expected.shape)}")
-        return False
-    diff = (got.detach().double() - expected.double()).abs().nan_to_num(math.inf)
-    if diff.max() <= 1e-5:
-        result.ok(f"{name} {tuple(got.shape)} matches the reference (largest difference {diff.max():.1e})")
-        return True
-    at = tuple(int(k) for k in torch.unravel_index(diff.argmax(), diff.shape))
-    result.fail(f"{name} differs at {int((diff > 1e-5).sum())} of {diff.numel()} entries; the largest difference, "
-                f"{diff[at]:.4f}, is at index {at}: got {got[at]:.4f}, expected {expected[at]:.4f}")
-    return False
-
-
-def _diagnose(result: CheckResult, got: Sequence, mistakes: list[tuple[str, tuple]], equation: str) -> None:
-    """Name the first known mistake that reproduces the student's outputs exactly."""
-    def same(a: Any, b: torch.Tensor) -> bool:
-        return (isinstance(a, torch.Tensor) and a.shape == b.shape
-                and torch.allclose(a.detach().double(), b.double(), atol=1e-5))
-    hint = next((h for h, outputs in mistakes if all(same(g, o) for g, o in zip(got, outputs))), None)
-    result.note(f"diagnosis: {hint}" if hint else f"compare each term with the equation: {equation}")
 
 
 # ------------------------------------------------------------------ the LSTM step: (a) and (d)
@@ -228,14 +154,6 @@ def check_gmu(student: type | nn.Module | Callable, seed: int = 0) -> CheckResul
 
 
 # ------------------------------------------------------------------ (c) a replacement bottleneck
-def _build(result: CheckResult, factory: Callable, *sizes: int, name: str = "factory") -> nn.Module | None:
-    module = _call(result, f"{name}{sizes}", factory, *sizes)
-    if module is None or isinstance(module, nn.Module):
-        return module
-    result.fail(f"{name}{sizes} returned a {type(module).__name__}", "return an nn.Module, so that it trains")
-    return None
-
-
 @torch.random.fork_rng(devices=[])
 def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = "lstm", seed: int = 0) -> CheckResult:
     """(c) A bottleneck that replaces the GMU, e.g. concatenation: h = tanh(W [f_act; f_lang] + b).
@@ -338,57 +256,4 @@ def check_signal_probs(probs: Sequence[float] | dict[str, float], drop: str | No
     return result
 
 
-# ------------------------------------------------------------------ (f) vocabulary and colours
-def check_vocabulary(words: Sequence[str], new: Sequence[str] = ()) -> CheckResult:
-    """(f) An extended vocabulary: the 23 words in their order, then the new ones (``new``, if given)."""
-    result, words = CheckResult("extended vocabulary"), list(words)
-    k = next((k for k, w in enumerate(VOCABULARY) if k >= len(words) or words[k] != w), None)
-    if k is not None:
-        result.fail(f"position {k} holds {words[k] if k < len(words) else 'nothing'!r}; expected {VOCABULARY[k]!r}",
-                    "keep the 23 words in their order and append the new ones: a word's index is its one-hot "
-                    "dimension and its row in every trained weight")
-    else:
-        result.ok(f"the {len(VOCABULARY)} words keep their order, <BOS/EOS> first")
-    if len(set(words)) < len(words):
-        result.fail(f"duplicate word(s) {sorted({w for w in words if words.count(w) > 1})}")
-    added = [w for w in words if w not in VOCABULARY]
-    for w in added:
-        if not isinstance(w, str) or not w or w != w.strip().lower() or " " in w or w in SIGNALS:
-            result.fail(f"{w!r} is not a lowercase word without spaces (nor a signal)",
-                        "tokenize splits on spaces: join two words with a hyphen, as in greenish-blue")
-    missing = [w for w in new if w not in added]
-    if missing:
-        result.fail(f"{missing} not among the new words {added}")
-    if result:
-        result.ok(f"new words {added}: {len(words)} output words, {len(words) + len(SIGNALS)} input dimensions")
-    return result
-
-
-def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2) -> CheckResult:
-    """(f) A new cube colour: one lowercase word and an opaque RGBA in [0, 1] that the camera can tell
-    apart from the other cubes and the table (some channel differs by ``min_difference`` or more)."""
-    from .sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
-
-    result, values = CheckResult(f"cube colour {name!r}"), [float(v) for v in rgba]
-    if not isinstance(name, str) or not name or name != name.lower() or " " in name:
-        result.fail(f"{name!r} should be one lowercase word (a hyphen joins two, as in greenish-blue)")
-    elif name in COLOURS:
-        result.fail(f"{name!r} is already one of the six colours of the dataset")
-    if max(values) > 1 or min(values) < 0:
-        result.fail(f"the values must lie in [0, 1]; got {tuple(values)}",
-                    "pybullet takes 0..1: divide 0..255 values by 255" if max(values) > 1 else None)
-    if len(values) != 4:
-        result.fail(f"an RGBA colour has 4 numbers; got {len(values)}", "add the alpha, 1.0" if len(values) == 3 else None)
-    elif values[3] != 1.0:
-        result.fail(f"alpha is {values[3]}; the cubes are opaque (alpha 1.0)")
-    if not result:
-        return result
-    others = {**{f"the {c} cube": v for c, v in CUBE_RGBA.items() if c != name}, "the table": TABLE_RGBA}
-    gaps = {o: max(abs(a - b) for a, b in zip(values, v[:3])) for o, v in others.items()}
-    closest = min(gaps, key=gaps.get)
-    if gaps[closest] < min_difference:
-        result.fail(f"too close to {closest}: no colour channel differs by more than {gaps[closest]:.2f}",
-                    f"the CAE sees R, G and B separately: make one channel differ by {min_difference} or more")
-    else:
-        result.ok(f"a valid opaque RGBA; the nearest is {closest}, {gaps[closest]:.2f} apart in the most different channel")
-    return result
+__all__ = ["check_peephole_step", "check_lstm_step", "check_gmu", "check_bottleneck", "check_signal_probs"]

@@ -1,0 +1,21 @@
+"""Check functions for the book's exercises: your version against the package's.
+
+Each check runs a student's code next to the reference on seeded random inputs and returns a
+:class:`CheckResult`: a short report (what matched; where and by how much it did not, with a hint
+tied to the paper's equation), truthy only when everything matched (``assert check_gmu(MyGMU)``).
+A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacement, the signals;
+Sec. 4: the vocabulary, and our simulator's cube colours.
+
+- ``result``  :class:`CheckResult` and how a check runs and compares student code
+- ``world``   chapters 01-03: ``check_vocabulary``, ``check_colour``
+- ``model``   chapters 04-05: ``check_peephole_step``, ``check_lstm_step``, ``check_gmu``,
+              ``check_bottleneck``, ``check_signal_probs``
+
+Every check is importable from here, e.g. ``from pgae_lite.exercises import check_gmu``.
+"""
+from .model import check_bottleneck, check_gmu, check_lstm_step, check_peephole_step, check_signal_probs
+from .result import CheckResult
+from .world import check_colour, check_vocabulary
+
+__all__ = ["CheckResult", "check_vocabulary", "check_colour", "check_peephole_step", "check_lstm_step", "check_gmu",
+           "check_bottleneck", "check_signal_probs"]

@@ -1,0 +1,103 @@
+"""Free-form instructions: the model is told a sentence instead of a description, and executes it.
+
+Paper, Sec. 3 and 5: PGAE-BERT "has the potential to recognise unseen natural
+language". :func:`execute_paraphrases` gives every test episode one of the
+held-out paraphrases of its own instruction (:mod:`pgae_lite.paraphrases`,
+e.g. "Could you shove the crimson cube forward in a hurry" for "push red
+fast") and executes it both ways, through :func:`instruction_features`
+(PGAE-BERT's transformer reads any text; PGAE's LSTM only its vocabulary, and
+says which words it does not know) and the paper's execute with those features
+(:func:`pgae_lite.evaluate.predict` with ``language=``, the open loop) as well
+as :func:`pgae_lite.closedloop.closed_loop`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import torch
+from tqdm.auto import tqdm
+
+from .cae import ChannelSeparatedCAE
+from .closedloop import execute_episode, spread, variation_of
+from .data import Normaliser, PGAEDataset
+from .evaluate import predict
+from .language import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
+from .paraphrases import Paraphrase, load_paraphrases
+from .patterns import Pattern
+from .pgae import PGAE
+from .pretrained import input_text
+from .signals import EOS, SIGNAL_TOKEN
+from .simdata import DatasetConfig
+
+
+@torch.no_grad()
+def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
+    """Instructions -> the language encoder's features under ``execute``, (B, D), for ``language=``.
+
+    PGAE-BERT's pretrained encoder reads any text, after the signal phrase
+    (``input_text("execute", text)``, as in training). PGAE's LSTM reads only
+    its vocabulary: every text must be a description (action colour speed),
+    else a :class:`~pgae_lite.language.LanguageError` names the unknown words.
+    """
+    encoder = model.language_encoder
+    if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
+        return encoder.encode_texts([input_text("execute", t) for t in texts])
+    for t in texts:
+        try:
+            parse_description(t)
+        except LanguageError as e:
+            raise LanguageError(f"PGAE's LSTM language encoder reads only its vocabulary, in the order "
+                                f"action colour speed (PGAE-BERT reads free text): {e}") from e
+    device = next(model.parameters()).device
+    tokens = torch.tensor([[SIGNAL_TOKEN + signal_index("execute"), *(WORD_INDEX[w] for w in tokenize(t)), EOS]
+                           for t in texts], device=device)                                   # (B, 5)
+    return encoder(tokens, torch.full((len(texts),), 5, device=device))
+
+
+def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
+    """The paraphrase an episode is given: of its pattern's meaning, number ``variation`` mod how many there are.
+
+    With the 3 paraphrases per test instruction and 6 variations, each is used twice.
+    None: no paraphrase has that meaning.
+    """
+    pat = Pattern.from_number(pattern)
+    mine = [p for p in paraphrases if p.meaning == (pat.action, pat.colour, pat.speed)]
+    return mine[variation % len(mine)] if mine else None
+
+
+def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
+                        paraphrases: list[Paraphrase] | None = None, split: str = "test", *,
+                        limit: int | None = None, closed: bool = True, config: DatasetConfig | None = None,
+                        tracking: bool = True, progress: bool = True) -> pd.DataFrame:
+    """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
+
+    Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
+    :func:`~pgae_lite.paraphrases.load_paraphrases`) is told one
+    (:func:`paraphrase_of`), encoded by :func:`instruction_features`: PGAE-BERT
+    reads it, PGAE's LSTM raises a LanguageError naming the unknown words before
+    anything runs. Then, as in :func:`~pgae_lite.closedloop.compare`: the paper's
+    execute (:func:`~pgae_lite.evaluate.predict` with ``language=``) run in the
+    simulator (``open_*`` columns) and, if ``closed``,
+    :func:`~pgae_lite.closedloop.closed_loop` (``closed_*``). nRMSE (%) is against
+    the recorded joints of the episode, the intended action. ``limit``: that many
+    episodes, evenly spread.
+    """
+    paraphrases = load_paraphrases() if paraphrases is None else paraphrases
+    subset = data.split(split)
+    told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
+    rows = np.flatnonzero([t is not None for t in told])
+    if not len(rows):
+        raise ValueError(f"no paraphrase has the meaning of any {split} episode")
+    rows = rows[spread(len(rows), limit)]
+    episodes, told = subset.subset(rows), [told[i] for i in rows]
+    language = instruction_features(model, [t.text for t in told])          # (N, D)
+    planned = predict(model, episodes, normaliser, "execute", language=language).joints   # the paper's execute
+    joint_range = data.joint_range()
+    return pd.DataFrame([
+        {**execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
+                           language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
+         "meaning": " ".join(told[k].meaning)}
+        for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
+
+
+__all__ = ["instruction_features", "paraphrase_of", "execute_paraphrases"]
