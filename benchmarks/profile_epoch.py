@@ -55,18 +55,21 @@ def lstm_flops(inputs: int, units: int, layers: int, steps: float) -> float:
     return 2 * 4 * units * sum((inputs if l == 0 else units) + units for l in range(layers)) * steps
 
 
-def epoch_flops(model_units: int = 100, layers: int = 2, hidden: int = 50) -> float:
-    """Expected forward + backward FLOP of one epoch: every sample once, signals drawn as the recipe draws them."""
+def epoch_flops(model_units: int = 100, layers: int = 2, hidden: int = 50, stride: int = 1) -> float:
+    """Expected forward + backward FLOP of one epoch: every sample once, signals drawn as the recipe draws them.
+
+    ``stride``: the model's time stride (the action LSTMs take one step per ``stride`` time steps).
+    """
     lengths = torch.as_tensor(train_set.lengths, dtype=torch.float64)
     mean_len = float(lengths.mean())
     p = torch.tensor(SIGNAL_PROBS, dtype=torch.float64)
     action_steps = float((p * torch.tensor([mean_len if a else 1.0 for a in ACTION_IN])).sum())
     lang_steps = float((p * torch.tensor([5.0 if w else 2.0 for w in LANG_IN])).sum())
     state = 2 * layers * model_units
-    per_sample = (lstm_flops(VISION_DIM + JOINT_DIM, model_units, layers, action_steps)      # action encoder
+    per_sample = (lstm_flops(VISION_DIM + JOINT_DIM, model_units, layers, action_steps / stride)   # action encoder
                   + lstm_flops(INPUT_DIM, model_units, layers, lang_steps)                  # language encoder
                   + lstm_flops(len(VOCABULARY), model_units, layers, 4)                     # language decoder
-                  + lstm_flops(VISION_DIM + JOINT_DIM, model_units, layers, mean_len - 1)   # action decoder
+                  + lstm_flops(VISION_DIM + JOINT_DIM, model_units, layers, (mean_len - 1) / stride)  # action decoder
                   + 2 * (2 * state * hidden + (2 * state) * hidden)                         # GMU
                   + 2 * 2 * hidden * state                                                  # decoder inits
                   + 2 * model_units * (len(VOCABULARY) * 4 + JOINT_DIM * (mean_len - 1)))  # read-outs
@@ -105,7 +108,8 @@ def where_time_goes(batch: int, bf16: bool) -> dict:
             "aten_calls_per_batch": round(calls / math.ceil(len(train_set) / batch))}
 
 
-flops = epoch_flops()
+model_cfg = get_profile(args.profile).model
+flops = epoch_flops(model_cfg.units, model_cfg.layers, model_cfg.hidden, model_cfg.time_stride)
 peaks = {"float32": peak(torch.float32), "bfloat16": peak(torch.bfloat16)}
 print(f"one epoch: {flops / 1e9:.1f} GFLOP; matmul peak here: float32 {peaks['float32']:.0f}, "
       f"bfloat16 {peaks['bfloat16']:.0f} GFLOP/s")
@@ -127,5 +131,5 @@ for batch in batches:
         print(f"batch {batch:3d} {'bf16' if bf16 else 'fp32'}: {seconds:.3f} s/epoch, "
               f"{row['samples_per_second']:.0f} samples/s, {row['gflops']:.0f} GFLOP/s "
               f"({row['share_of_float32_peak_%']:.0f}% of the float32 peak); time: {row['share_%']}")
-bench.write({"epoch_gflop": round(flops / 1e9, 2), "peak_gflops": {k: round(v, 1) for k, v in peaks.items()},
+bench.write({"time_stride": model_cfg.time_stride, "epoch_gflop": round(flops / 1e9, 2), "peak_gflops": {k: round(v, 1) for k, v in peaks.items()},
              "training_samples": len(train_set), "rows": rows})
