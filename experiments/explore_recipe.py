@@ -1,6 +1,6 @@
 """Exploration: train with periodic test evaluation (learning curve).
 
-    python benchmarks/explore_recipe.py --epochs 300 --seed 0 [--sim] [--set key=value ...] [--model key=value ...]
+    python experiments/explore_recipe.py --epochs 300 --seed 0 [--sim] [--set key=value ...] [--model key=value ...]
 
 On the authors' data by default; ``--sim`` uses the book profile's simulated data.
 """
