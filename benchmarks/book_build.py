@@ -1,6 +1,6 @@
 """Time the whole book: `jupyter-book build .` executing every chapter, and the time of each.
 
-    python benchmarks/book_build.py [--profile book] [--fresh-cache] [--keep-build]
+    python benchmarks/book_build.py [--profile book] [--fresh-cache]
 
 Runs in a copy-free way on this checkout: the book's execution cache
 (_build/.jupyter_cache) is cleared first, so every chapter really executes.

@@ -1,30 +1,32 @@
-"""Speed (and, with --profile, quality) of the channel-separated CAE on a CPU or GPU.
+"""Speed (and, with --train, quality) of the channel-separated CAE on a CPU or GPU.
 
-    python benchmarks/cae_speed.py [--threads 1 2] [--batches 16 32 200] [--seconds 8]
-    python benchmarks/cae_speed.py --profile book [--data sim --episodes 48] [--threads 2]
+    python benchmarks/cae_speed.py [--batches 16 32 200] [--seconds 8] [--threads 1]
+    python benchmarks/cae_speed.py --train [--profile book] [--data sim --episodes 48] [--threads 2]
 
-Without --profile it times training steps (forward, BCE, backward, Adam) at each
-batch size, and feature extraction (``extract_features``), in ms per image.
-With --profile it trains that CAE profile end to end on tabletop frames and
+Without --train it times training steps (forward, BCE, backward, Adam) of a
+CAE of the default architecture at each batch size, and feature extraction
+(``extract_features``), in ms per image; writes results/cae_speed.json.
+With --train it trains the profile's CAE end to end on tabletop frames and
 reports the wall time, ms per iteration, the final training loss and, on
 held-out frames, the BCE above its floor (the BCE of a perfect reconstruction,
-which is not 0 for grey pixels) next to that of the mean training image.
-Frames: ``synthetic`` (numpy: a table, an arm, two coloured cubes; no
-simulator needed) or ``sim`` (episodes of ``pgae_lite.sim.record_episode``).
-Each result is printed and appended as a json line to benchmarks/out/cae_speed.jsonl.
-Run it on an otherwise idle machine.
+which is not 0 for grey pixels) next to that of the mean training image;
+writes results/cae_speed-train.json. Frames: ``synthetic`` (numpy: a table,
+an arm, two coloured cubes; no simulator needed) or ``sim`` (episodes of
+``pgae_lite.sim.record_episode``); the same frames for every seed, which
+seeds the CAE's weights (a row per seed). One thread count per run
+(``--threads``; compare counts with one run each and ``--out``). Run it on an
+otherwise idle machine.
 """
-import argparse
-import json
+from __future__ import annotations
+
 import os
-import platform
 import time
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import torch
 
+from harness import Benchmark
 from pgae_lite.cae import (
     ChannelSeparatedCAE,
     extract_features,
@@ -111,74 +113,69 @@ def time_extraction(model, x, seconds) -> float:
     return (time.perf_counter() - t0) / n
 
 
-ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
-ap.add_argument("--batches", type=int, nargs="+", default=[16, 32])
-ap.add_argument("--seconds", type=float, default=8.0, help="time budget per measurement")
-ap.add_argument("--profile", help="train this CAE profile end to end (smoke / book / paper)")
-ap.add_argument("--iterations", type=int, help="override the profile's iterations")
-ap.add_argument("--data", choices=["synthetic", "sim"], default="synthetic")
-ap.add_argument("--episodes", type=int, default=48, help="episodes of frames for --profile")
-ap.add_argument("--stride", type=int, default=4, help="every k-th frame of those episodes")
-ap.add_argument("--png", help="with --profile: save test frames above their reconstructions here")
-args = ap.parse_args()
+def trained_row(args, seed: int, device: torch.device) -> dict:
+    """Train the profile's CAE (seeded ``seed``) on ``--data`` frames; its time and reconstruction quality."""
+    config = replace(get_profile(args.profile).cae, seed=seed,
+                     **({"iterations": args.iterations} if args.iterations else {}))
+    data = frames(args.data, args.episodes, args.stride, seed=0)
+    test = frames(args.data, max(2, args.episodes // 8), 4, seed=1)
+    t0 = time.perf_counter()
+    model, history = train_cae(data, config, device=device, progress=False)
+    seconds = time.perf_counter() - t0
+    with torch.no_grad():
+        test_bce = sum(model.loss(test[i:i + 128])[0].item() * len(test[i:i + 128])
+                       for i in range(0, len(test), 128)) / len(test)
+    x, mean = test / 255.0, data.mean(0) / 255.0
+    floor = bce_floor(x)
+    rec = reconstruct(model, test)
+    return {"seed": seed, "cae": config.name, "images": len(data), "batch": config.batch_size,
+            "iterations": config.iterations, "train_s": round(seconds, 1),
+            "ms_per_iteration": round(seconds / config.iterations * 1000, 1),
+            "final_loss": round(float(np.mean([h["loss"] for h in history[-50:]])), 4),
+            "test_bce_above_floor": round(test_bce - floor, 4),
+            "mean_image_bce_above_floor": round(bce_floor(x, mean) - floor, 4),
+            "test_mae_0_255": round(float(np.abs(rec.astype(float) - test).mean()), 2),
+            "extract_ms_per_image": round(time_extraction(model, test[:256], 2.0) * 1000, 3)}
 
-x_device = default_device()
-out = Path(__file__).parent / "out" / "cae_speed.jsonl"
-out.parent.mkdir(parents=True, exist_ok=True)
-base = {"device": str(x_device), "cpu": platform.processor() or platform.machine(), "torch": torch.__version__,
-        "load_avg_1min": os.getloadavg()[0]}  # > 0.5 before we start: another job shares the cores
-if x_device.type == "cuda":
-    base["gpu"] = torch.cuda.get_device_name()
-rows = []
-for threads in args.threads:
-    torch.set_num_threads(threads)
-    if args.profile:
-        config = replace(get_profile(args.profile).cae, **({"iterations": args.iterations} if args.iterations else {}))
-        data = frames(args.data, args.episodes, args.stride, seed=0)
-        test = frames(args.data, max(2, args.episodes // 8), 4, seed=1)
-        t0 = time.perf_counter()
-        model, history = train_cae(data, config, device=x_device, progress=False)
-        seconds = time.perf_counter() - t0
-        with torch.no_grad():
-            test_bce = sum(model.loss(test[i:i + 128])[0].item() * len(test[i:i + 128])
-                           for i in range(0, len(test), 128)) / len(test)
-        x, mean = test / 255.0, data.mean(0) / 255.0
-        floor = bce_floor(x)
-        rec = reconstruct(model, test)
-        row = {**base, "profile": config.name, "data": args.data, "threads": threads, "images": len(data),
-               "batch": config.batch_size, "iterations": config.iterations, "train_s": round(seconds, 1),
-               "ms_per_iteration": round(seconds / config.iterations * 1000, 1),
-               "final_loss": round(float(np.mean([h["loss"] for h in history[-50:]])), 4),
-               "test_bce_above_floor": round(test_bce - floor, 4),
-               "mean_image_bce_above_floor": round(bce_floor(x, mean) - floor, 4),
-               "test_mae_0_255": round(float(np.abs(rec.astype(float) - test).mean()), 2),
-               "extract_ms_per_image": round(time_extraction(model, test[:256], 2.0) * 1000, 3)}
-        if args.png:
-            import matplotlib
-            matplotlib.use("Agg")
-            import matplotlib.pyplot as plt
-            pick = np.linspace(0, len(test) - 1, 6).astype(int)
-            fig, axes = plt.subplots(2, 6, figsize=(15, 4))
-            for j, i in enumerate(pick):
-                axes[0, j].imshow(test[i])
-                axes[1, j].imshow(rec[i])
-            for a in axes.flat:
-                a.axis("off")
-            fig.tight_layout()
-            fig.savefig(args.png, dpi=70)
-    else:
-        x = frames("synthetic", 13, 1, seed=0)[:512]                     # 512 frames
-        torch.manual_seed(0)
-        model = ChannelSeparatedCAE().to(x_device)
-        opt = torch.optim.Adam(model.parameters(), 1e-3)
-        row = {**base, "threads": threads}
-        for batch in args.batches:
-            dt = time_steps(model.train(), opt, x, batch, args.seconds)
-            row[f"train_b{batch}_ms_per_iteration"] = round(dt * 1000, 1)
-            row[f"train_b{batch}_ms_per_image"] = round(dt / batch * 1000, 2)
-        row["extract_ms_per_image"] = round(time_extraction(model, x[:256], args.seconds) * 1000, 3)
-    rows.append(row)
-    print(json.dumps(row), flush=True)
-    with out.open("a") as f:
-        f.write(json.dumps(row) + "\n")
+
+def speed_row(args, seed: int, device: torch.device) -> dict:
+    """Training steps at each batch size and feature extraction of a fresh CAE (seeded ``seed``), ms per image."""
+    x = frames("synthetic", 13, 1, seed=0)[:512]                         # 512 frames
+    torch.manual_seed(seed)
+    model = ChannelSeparatedCAE().to(device)
+    opt = torch.optim.Adam(model.parameters(), 1e-3)
+    row = {"seed": seed}
+    for batch in args.batches:
+        dt = time_steps(model.train(), opt, x, batch, args.seconds)
+        row[f"train_b{batch}_ms_per_iteration"] = round(dt * 1000, 1)
+        row[f"train_b{batch}_ms_per_image"] = round(dt / batch * 1000, 2)
+    row["extract_ms_per_image"] = round(time_extraction(model, x[:256], args.seconds) * 1000, 3)
+    return row
+
+
+def main() -> None:
+    bench = Benchmark("cae_speed", __doc__)
+    bench.parser.add_argument("--batches", type=int, nargs="+", default=[16, 32], help="batch sizes (without --train)")
+    bench.parser.add_argument("--seconds", type=float, default=8.0, help="time budget per measurement")
+    bench.parser.add_argument("--train", action="store_true", help="train the profile's CAE end to end")
+    bench.parser.add_argument("--iterations", type=int, help="with --train: override the profile's iterations")
+    bench.parser.add_argument("--data", choices=["synthetic", "sim"], default="synthetic",
+                              help="with --train: the frames")
+    bench.parser.add_argument("--episodes", type=int, default=48, help="with --train: episodes of frames")
+    bench.parser.add_argument("--stride", type=int, default=4, help="with --train: every k-th frame of those episodes")
+    args = bench.parse()
+    if args.train:
+        bench.name = "cae_speed-train"         # results/cae_speed-train.json
+    device = default_device()
+    load = os.getloadavg()[0]                  # > 0.5 before we start: another job shares the cores
+    rows = []
+    for seed in args.seeds:
+        rows.append(trained_row(args, seed, device) if args.train else speed_row(args, seed, device))
+        print(rows[-1], flush=True)
+    bench.write({"mode": "train" if args.train else "steps", "device": str(device), "load_average": load,
+                 **({"data": args.data, "episodes": args.episodes, "stride": args.stride} if args.train
+                    else {"batches": args.batches}), "rows": rows})
+
+
+if __name__ == "__main__":
+    main()

@@ -24,35 +24,42 @@ from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 
-bench = Benchmark("closed_loop", __doc__, seeds=[0, 1, 2])
-bench.parser.add_argument("--trainings", nargs="+", default=["PGAE", "PGAE-BERT"])
-bench.parser.add_argument("--limit", type=int, default=None, help="this many test episodes, evenly spread")
-bench.parser.add_argument("--no-tracking", action="store_true", help="send the model's joints to the motors as they are")
-args = bench.parse()
 
-cae, _ = trained_cae(args.profile, "cpu", progress=False)
-data = simulated_dataset(args.profile, "cpu", progress=False)
-runs = []
-for training in args.trainings:
-    for seed in args.seeds:
-        trained = trained_pgae(training, args.profile, seed, device="cpu", progress=False)
-        t0 = time.perf_counter()
-        table = compare(trained.model, cae, trained.normaliser, data, limit=args.limit,
-                        config=get_profile(args.profile).data, tracking=not args.no_tracking)
-        seconds = time.perf_counter() - t0
-        summary = success_summary(table)
-        open_, closed = 100 * table["open_passed"].mean(), 100 * table["closed_passed"].mean()
-        print(f"\n== {training}, seed {seed}: open loop {open_:.1f}%, closed loop {closed:.1f}% "
-              f"({len(table)} episodes, {seconds / len(table):.2f} s each)")
-        print(summary.round(2).to_string())
-        failed = table[~table["closed_passed"]]
-        cells, _ = evaluate(trained.model, data, trained.normaliser)
-        runs.append({"training": training, "seed": seed, "episodes": len(table),
-                     "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
-                     "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
-                     "seconds_per_episode": round(seconds / len(table), 3),
-                     "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
-                     "summary": summary.reset_index().round(2).to_dict(orient="records"),
-                     "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
-                     .to_dict(orient="records")})
-bench.write({"limit": args.limit, "tracking": not args.no_tracking, "runs": runs})
+def main() -> None:
+    bench = Benchmark("closed_loop", __doc__, seeds=[0, 1, 2])
+    bench.parser.add_argument("--trainings", nargs="+", default=["PGAE", "PGAE-BERT"])
+    bench.parser.add_argument("--limit", type=int, default=None, help="this many test episodes, evenly spread")
+    bench.parser.add_argument("--no-tracking", action="store_true",
+                              help="send the model's joints to the motors as they are")
+    args = bench.parse()
+
+    cae, _ = trained_cae(args.profile, "cpu", progress=False)
+    data = simulated_dataset(args.profile, "cpu", progress=False)
+    runs = []
+    for training in args.trainings:
+        for seed in args.seeds:
+            trained = trained_pgae(training, args.profile, seed, device="cpu", progress=False)
+            t0 = time.perf_counter()
+            table = compare(trained.model, cae, trained.normaliser, data, limit=args.limit,
+                            config=get_profile(args.profile).data, tracking=not args.no_tracking)
+            seconds = time.perf_counter() - t0
+            summary = success_summary(table)
+            open_, closed = 100 * table["open_passed"].mean(), 100 * table["closed_passed"].mean()
+            print(f"\n== {training}, seed {seed}: open loop {open_:.1f}%, closed loop {closed:.1f}% "
+                  f"({len(table)} episodes, {seconds / len(table):.2f} s each)")
+            print(summary.round(2).to_string())
+            failed = table[~table["closed_passed"]]
+            cells, _ = evaluate(trained.model, data, trained.normaliser)
+            runs.append({"training": training, "seed": seed, "episodes": len(table),
+                         "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
+                         "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
+                         "seconds_per_episode": round(seconds / len(table), 3),
+                         "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
+                         "summary": summary.reset_index().round(2).to_dict(orient="records"),
+                         "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
+                         .to_dict(orient="records")})
+    bench.write({"limit": args.limit, "tracking": not args.no_tracking, "runs": runs})
+
+
+if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
+    main()

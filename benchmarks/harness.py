@@ -2,11 +2,20 @@
 
     from harness import Benchmark             # benchmarks/ is on sys.path when a script there runs
 
-    bench = Benchmark("table1", __doc__)      # --threads, --out, --profile, --seeds, --quick
-    bench.parser.add_argument("--rows", default="PGAE")
-    args = bench.parse()                      # sets torch's threads once, here
-    ...
-    bench.write({"rows": ...})                # results/table1.json (or --out)
+    def main() -> None:
+        bench = Benchmark("table1", __doc__)  # --threads, --out, --profile, --seeds
+        bench.parser.add_argument("--rows", default="PGAE")
+        args = bench.parse()                  # sets torch's threads once, here
+        ...
+        bench.write({"rows": ...})            # results/table1.json (or --out)
+
+    if __name__ == "__main__":
+        main()
+
+The work runs under the ``__main__`` guard: recording the simulated data
+(:func:`pgae_lite.simdata.generate`, which :func:`pgae_lite.pipeline.simulated_dataset`
+and ``trained_cae`` call when the cache lacks it) spawns worker processes, and
+each re-imports the script; unguarded, they would run the benchmark again.
 
 A result file is JSON::
 

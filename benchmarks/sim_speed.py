@@ -1,9 +1,10 @@
 """Speed and reliability of the simulator: ms per frame, s per episode, first-try success.
 
-    python benchmarks/sim_speed.py [--arrangements 0 3 6 9] [--variation 0] [--workers 1]
+    python benchmarks/sim_speed.py [--arrangements 0 3 6 9] [--variation 0] [--workers 1] [--profile book]
 
 Records a sample of episodes (every one of the 12 actions on each chosen
-arrangement, both views) with :func:`pgae_lite.sim.record_episode` and reports:
+arrangement, both views) with :func:`pgae_lite.sim.record_episode`, in the
+simulator settings of the profile's dataset, and reports:
 
 - ms per rendered frame (NICO's eye, mid-action; the backdrop-merge renderer
   and, for comparison, a full TinyRenderer pass over everything),
@@ -12,31 +13,27 @@ arrangement, both views) with :func:`pgae_lite.sim.record_episode` and reports:
 - the projected time for the 864-episode dataset with ``--workers`` processes
   (864 x s/episode / workers; measured with that many workers if > 1).
 
-Appends one JSON line to benchmarks/out/sim_speed.jsonl. Timings depend on
-what else runs on the machine: the load average is recorded with them.
+Writes results/sim_speed.json. Timings depend on what else runs on the
+machine: the load average is recorded with them.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import platform
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict
-from pathlib import Path
 
 import numpy as np
 
+from harness import Benchmark
+from pgae_lite.config import get_profile
 from pgae_lite.patterns import Pattern, pattern_number
 from pgae_lite.sim import SimConfig, Simulation, record_episode
 
-OUT = Path(__file__).resolve().parent / "out" / "sim_speed.jsonl"
 
-
-def frame_times(n: int = 200) -> dict[str, float]:
+def frame_times(config: SimConfig, n: int = 200) -> dict[str, float]:
     """Render NICO's view ``n`` times mid-action (pull right cube, slow): ms per frame."""
-    sim = Simulation(SimConfig())
+    sim = Simulation(config)
     sim.reset(4, 0, render=False)
     for q in sim.plan().joints[:45]:
         sim.step(q, render=False)
@@ -55,27 +52,29 @@ def frame_times(n: int = 200) -> dict[str, float]:
     return out
 
 
-def one(job: tuple[int, int]) -> dict:
-    pattern, variation = job
+def one(job: tuple[int, int, SimConfig]) -> dict:
+    pattern, variation, config = job
     t = time.perf_counter()
-    ep = record_episode(pattern, variation)
+    ep = record_episode(pattern, variation, config)
     return {"pattern": pattern, "seconds": time.perf_counter() - t, "attempts": ep.attempts,
             "frames": 2 * len(ep.joints), "tracking": ep.info["tracking_error"],
             "tracking_opposite": ep.info["tracking_error_opposite"]}
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--arrangements", type=int, nargs="+", default=[0, 3, 6, 9])
-    ap.add_argument("--variation", type=int, default=0)
-    ap.add_argument("--workers", type=int, default=1)
-    args = ap.parse_args()
+    bench = Benchmark("sim_speed", __doc__)
+    bench.parser.add_argument("--arrangements", type=int, nargs="+", default=[0, 3, 6, 9])
+    bench.parser.add_argument("--variation", type=int, default=0)
+    bench.parser.add_argument("--workers", type=int, default=1)
+    args = bench.parse()
+    config = get_profile(args.profile).data.sim
 
-    frames = frame_times()
+    frames = frame_times(config)
     print(f"render: {frames['render_ms']:.2f} ms/frame (best {frames['render_best_ms']:.2f}); "
           f"full TinyRenderer pass: {frames['full_render_ms']:.2f} ms")
 
-    jobs = [(pattern_number(s, a, i), args.variation) for a in args.arrangements for s in (0, 1) for i in range(6)]
+    jobs = [(pattern_number(s, a, i), args.variation, config)
+            for a in args.arrangements for s in (0, 1) for i in range(6)]
     record_episode(*jobs[0])                               # warm up (imports, URDF file)
     t0 = time.perf_counter()
     if args.workers > 1:
@@ -99,18 +98,14 @@ def main() -> None:
           f"opposite {max(r['tracking_opposite'] for r in rows):.3f} rad")
     print(f"projected 864 episodes: {projected / 60:.1f} min with {args.workers} worker(s); "
           f"{projected_2 / 60:.1f} min with 2 workers on 2 cores")
-    record = {"time": time.strftime("%Y-%m-%dT%H:%M:%S"), "machine": platform.node(), "cpus": os.cpu_count(),
-              "load_average": os.getloadavg(), "workers": args.workers, "episodes": len(rows),
-              **frames, "seconds_per_episode": per_episode, "seconds_slow": float(slow.mean()),
-              "seconds_fast": float(fast.mean()), "first_try_success": float(first_try),
-              "max_tracking_error": max(max(r["tracking"], r["tracking_opposite"]) for r in rows),
-              "projected_minutes": projected / 60, "projected_minutes_2_workers": projected_2 / 60,
-              "config": asdict(SimConfig())}
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    with open(OUT, "a") as f:
-        f.write(json.dumps(record) + "\n")
-    print(f"appended to {OUT}")
+    bench.write({"load_average": os.getloadavg(), "workers": args.workers, "arrangements": args.arrangements,
+                 "variation": args.variation, "episodes": len(rows),
+                 **frames, "seconds_per_episode": per_episode, "seconds_slow": float(slow.mean()),
+                 "seconds_fast": float(fast.mean()), "first_try_success": float(first_try),
+                 "max_tracking_error": max(max(r["tracking"], r["tracking_opposite"]) for r in rows),
+                 "projected_minutes": projected / 60, "projected_minutes_2_workers": projected_2 / 60,
+                 "config": asdict(config)})
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":   # --workers N spawns processes, which re-import this file
     main()

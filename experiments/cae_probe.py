@@ -1,13 +1,13 @@
 """Linear probe: do the CAE's first-frame features name the left and right cube colours?
 
-    python benchmarks/cae_probe.py [--profile book]
+    python experiments/cae_probe.py [--profile book]
 
 Fits a multinomial logistic regression (one linear layer, L-BFGS) from the 30
 visual features of an episode's first frame to the colour of the left cube,
 and another to the colour of the right cube, on the training split; reports
 accuracy on the test split, for NICO's own view and for the opposite view.
 Uses the cached dataset (``pgae_lite.pipeline.simulated_dataset``). Appends a
-JSON line to ``benchmarks/out/cae_probe.jsonl``.
+JSON line to ``experiments/out/cae_probe.jsonl``.
 """
 import argparse
 import json

@@ -1,6 +1,6 @@
 """The most any read-out of the frozen transformer gets from the paraphrases: trained probes.
 
-    python benchmarks/paraphrase_readout.py [--model NAME] [--carriers 20] [--out benchmarks/out/paraphrase_readout.json]
+    python experiments/paraphrase_readout.py [--model NAME] [--carriers 20] [--out experiments/out/paraphrase_readout.json]
 
 PGAE-BERT reads a sentence only through the frozen transformer. Here small
 classifiers are trained on the transformer's outputs for the sentences
@@ -42,7 +42,7 @@ from pgae_lite.pretrained import PretrainedLanguageEncoder, input_text
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--model", default=None, help="Hugging Face name or folder (default: the shipped all-MiniLM-L6-v2)")
 ap.add_argument("--carriers", type=int, default=20, help="generated carrier sentences per meaning (default: 20)")
-ap.add_argument("--out", default="benchmarks/out/paraphrase_readout.json")
+ap.add_argument("--out", default="experiments/out/paraphrase_readout.json")
 args = ap.parse_args()
 torch.manual_seed(0)
 rng = random.Random(0)

@@ -1,6 +1,6 @@
 """How much do the six recordings of a pattern differ? A floor under any model's joint error.
 
-    python benchmarks/variation_floor.py [--every 7] [--set timing_jitter=0.15 ...]
+    python experiments/variation_floor.py [--every 7] [--set timing_jitter=0.15 ...]
 
 A model that executes "push red slowly" gets the description and the first
 step; it cannot know the parts of a recording's random variation that the
@@ -13,7 +13,7 @@ setting) as nRMSE in % of the joints' range (4.04 rad on the book data), for
 the default :class:`~pgae_lite.sim.SimConfig` and with single jitters turned
 off, so one can see which jitter costs what.
 
-Appends one JSON line per run to benchmarks/out/variation_floor.jsonl.
+Appends one JSON line per run to experiments/out/variation_floor.jsonl.
 """
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """How far can the frozen transformer alone take a paraphrase? Nearest fixed-vocabulary instruction by cosine.
 
-    python benchmarks/paraphrase_similarity.py [--model NAME] [--out benchmarks/out/paraphrase_similarity.json]
+    python experiments/paraphrase_similarity.py [--model NAME] [--out experiments/out/paraphrase_similarity.json]
 
 PGAE-BERT sees a paraphrase only as the transformer's sentence vector. Before
 blaming (or crediting) PGAE, ask the transformer itself: for each of the 108
@@ -25,7 +25,7 @@ from pgae_lite.pretrained import PretrainedLanguageEncoder, fixed_token_rows, in
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--model", default=None, help="Hugging Face name or folder (default: the shipped all-MiniLM-L6-v2)")
-ap.add_argument("--out", default="benchmarks/out/paraphrase_similarity.json")
+ap.add_argument("--out", default="experiments/out/paraphrase_similarity.json")
 args = ap.parse_args()
 
 encoder = PretrainedLanguageEncoder(args.model)

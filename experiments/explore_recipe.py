@@ -1,0 +1,65 @@
+"""Exploration: train with periodic test evaluation (learning curve).
+
+    python experiments/explore_recipe.py --epochs 300 --seed 0 [--sim] [--set key=value ...] [--model key=value ...]
+
+On the authors' data by default; ``--sim`` uses the book profile's simulated data.
+"""
+import argparse, json, time
+from pathlib import Path
+
+import torch
+from dataclasses import replace
+
+from pgae_lite.config import get_profile
+from pgae_lite.evaluate import evaluate
+from pgae_lite.original import load_original
+from pgae_lite.pipeline import simulated_dataset
+from pgae_lite.train import train
+
+
+def overrides(pairs):
+    return {k: json.loads(v) if v[:1] in "0123456789.-[{tfn" else v for k, v in (s.split("=", 1) for s in pairs)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--data", default="../shared/pgae-original-data")
+    ap.add_argument("--epochs", type=int, default=300)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--every", type=int, default=25)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--set", nargs="*", default=[], help="TrainConfig overrides key=value")
+    ap.add_argument("--model", nargs="*", default=[], help="ModelConfig overrides key=value")
+    ap.add_argument("--sim", action="store_true", help="the simulated data (book profile) instead of the authors'")
+    ap.add_argument("--log", default=None)
+    ap.add_argument("--save", default=None, help="folder for the checkpoint (default: none saved)")
+    a = ap.parse_args()
+    torch.set_num_threads(a.threads)
+
+    prof = get_profile("book", epochs=a.epochs, seed=a.seed, **overrides(a.set))
+    prof.model = replace(prof.model, **overrides(a.model))
+    ds = simulated_dataset("book", progress=False) if a.sim else load_original(a.data)
+    t0 = time.perf_counter()
+    rows = []
+
+    def cb(epoch, model, rec):
+        if epoch % a.every and epoch != a.epochs:
+            return
+        t = time.perf_counter() - t0
+        from pgae_lite.data import Normaliser
+        norm = Normaliser.fit(ds.split("train"), prof.train.vision_scaling)
+        res, _ = evaluate(model, ds, norm)
+        line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
+                **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
+                "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}
+        rows.append(line)
+        print(json.dumps(line), flush=True)
+
+    tr = train(ds, prof, out_dir=a.save, progress=False, callback=cb)
+    print("train seconds", round(tr.seconds))
+    if a.log:
+        Path(a.log).write_text(json.dumps({"argv": vars(a), "train_seconds": tr.seconds, "rows": rows}))
+
+
+if __name__ == "__main__":   # --sim may record the data: its workers are spawned and re-import this file
+    main()
