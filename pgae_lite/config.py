@@ -78,7 +78,7 @@ class TrainConfig:
     warmup: float = 0.03                # fraction of steps of linear warm-up
     clip: float | None = 1.0            # gradient-norm clipping (paper: none)
     # Deviation from paper: decoupled weight decay (AdamW; paper: Adam, none). Measured on our data
-    # (3 seeds, benchmarks/explore_recipe.py): describe 78/89/74% -> 92/94/90%, execute nRMSE median
+    # (3 seeds, experiments/explore_recipe.py): describe 78/89/74% -> 92/94/90%, execute nRMSE median
     # 0.479 -> 0.451%, repeat action 0.487 -> 0.461%. Smaller weights favour one rule shared by all
     # actions ("say the moved cube's colour") over a table of action-specific ones.
     weight_decay: float = 0.1
@@ -100,7 +100,7 @@ class TrainConfig:
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
     # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
     # see data.Normaliser; authors: "global", one min and max over all 30 features). Measured on our
-    # data (3 seeds, benchmarks/explore_recipe.py --sim): describe 91.7/94.4/90.3% -> 95.4/98.1/93.1%,
+    # data (3 seeds, experiments/explore_recipe.py --sim): describe 91.7/94.4/90.3% -> 95.4/98.1/93.1%,
     # execute nRMSE median 0.451 -> 0.453%, repeat action 0.461 -> 0.462%.
     vision_scaling: str = "whiten"
     language_weight: float = 1.0        # α

@@ -58,7 +58,7 @@ class SimConfig:
     # (when each phase starts, how far the cube is pushed) puts a floor under any model's joint
     # error. With cube jitter +-1 cm, travel 8-10 cm and timing x[0.85, 1.15], the six recordings of
     # a pattern spread by 0.77% nRMSE around their mean (planned joints), above the paper's 0.44%;
-    # with the values below, 0.34% (benchmarks/variation_floor.py).
+    # with the values below, 0.34% (experiments/variation_floor.py).
     cube_jitter: float = 0.005                # cube centres move by up to +-5 mm in x and y
     distance: tuple[float, float] = (0.085, 0.095)   # planned cube travel (m), uniform
     lateral_jitter: float = 0.006             # contact point across the direction, +- (m)
