@@ -278,7 +278,7 @@ def animate(rollout: Execution, every: int = 2, fps: float = 10.0, size: float =
     """The rollout seen from NICO's eye, with its measured joints: a matplotlib animation.
 
     Show it in a notebook with ``IPython.display.HTML(animate(rollout).to_jshtml())``
-    (see :func:`pgae_lite.viz.animate_frames`).
+    (see :func:`pgae_lite.viz.scenes.animate_frames`).
     """
     if rollout.frames is None:
         raise ValueError("this rollout has no frames: run open_loop(..., render=True), or use closed_loop")

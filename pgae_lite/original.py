@@ -35,7 +35,7 @@ def _read_matrix(path: Path, width: int) -> np.ndarray:
 def load_original(path: str | Path) -> PGAEDataset:
     """Read the authors' dataset (the folder holding ``target/`` and ``actions.txt``).
 
-    Raises :class:`DataFormatError` naming what was expected when the folder,
+    Raises :class:`~pgae_lite.data.DataFormatError` naming what was expected when the folder,
     a sub-tree or a file is missing or malformed.
     """
     root = Path(path).expanduser()

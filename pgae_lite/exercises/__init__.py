@@ -1,12 +1,12 @@
 """Check functions for the book's exercises: your version against the package's.
 
 Each check runs a student's code next to the reference on seeded random inputs and returns a
-:class:`CheckResult`: a short report (what matched; where and by how much it did not, with a hint
+:class:`~pgae_lite.exercises.result.CheckResult`: a short report (what matched; where and by how much it did not, with a hint
 tied to the paper's equation), truthy only when everything matched (``assert check_gmu(MyGMU)``).
 A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacement, the signals;
 Sec. 4: the vocabulary, and our simulator's cube colours.
 
-- ``result``  :class:`CheckResult` and how a check runs and compares student code
+- ``result``  :class:`~pgae_lite.exercises.result.CheckResult` and how a check runs and compares student code
 - ``world``   chapters 01-03: ``check_vocabulary``, ``check_colour``
 - ``model``   chapters 04-05: ``check_peephole_step``, ``check_lstm_step``, ``check_gmu``,
               ``check_bottleneck``, ``check_signal_probs``
