@@ -30,6 +30,11 @@ from .signals import SignalBatch
 WORDS = len(VOCABULARY)
 
 
+def lstm_steps_of(steps: torch.Tensor, stride: int) -> torch.Tensor:
+    """LSTM steps that cover ``steps`` time steps, ``stride`` per LSTM step: ceil(steps / stride)."""
+    return torch.div(steps + stride - 1, stride, rounding_mode="floor")
+
+
 def embedding_init_(rnn: nn.Module) -> None:
     """Initialise the input weights of an LSTM fed one-hot words like a word embedding, N(0, 1).
 
@@ -85,10 +90,7 @@ class ActionEncoder(nn.Module):
 
     def forward(self, inputs: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         k = self.stride                                         # inputs (B, T, 35), lengths (B,)
-        if k > 1:
-            inputs = inputs[:, ::k]                             # (B, ceil(T/k), 35)
-            lengths = torch.div(lengths + k - 1, k, rounding_mode="floor")
-        _, state = self.rnn(inputs, lengths)
+        _, state = self.rnn(inputs[:, ::k], lstm_steps_of(lengths, k))   # (B, ceil(T/k), 35)
         return state_to_vector(state)                           # (B, 400)
 
 
@@ -182,9 +184,7 @@ class ActionDecoder(nn.Module):
         """
         k, S = self.stride, vision.shape[1]
         run = self._fused if self.feedback == "start" else self._free_running
-        if k == 1:
-            return run(self.begin(h), vision, start, steps)
-        lstm_steps = None if steps is None else torch.div(steps + k - 1, k, rounding_mode="floor")
+        lstm_steps = None if steps is None else lstm_steps_of(steps, k)
         poses = run(self.begin(h), vision[:, ::k], start, lstm_steps)         # (B, ceil(S/k), 5k)
         joints = poses.reshape(len(h), -1, JOINT_DIM)[:, :S]                  # (B, S, 5)
         if steps is not None:                                                 # 0 past a sample's last step
@@ -197,10 +197,7 @@ class ActionDecoder(nn.Module):
         # and test run the same single fused pass over all steps.
         prev = start[:, None].expand(-1, vision.shape[1], -1)                 # (B, S, 5)
         y, _ = self.rnn(torch.cat([vision, prev], 2), steps, state)          # each sample for its own steps
-        joints = torch.tanh(self.out(y))                                      # (B, S, 5k)
-        if steps is not None:                                                 # 0 past a sample's last step
-            joints = joints * (torch.arange(vision.shape[1], device=vision.device) < steps[:, None])[..., None]
-        return joints
+        return torch.tanh(self.out(y))                                        # (B, S, 5k)
 
     def _free_running(self, state, vision: torch.Tensor, start: torch.Tensor,
                       steps: torch.Tensor | None) -> torch.Tensor:
