@@ -26,7 +26,7 @@ from .data import JOINT_DIM, Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .pgae import PGAE
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
-from .utils import CheckpointMismatchError, atomic_path, default_device
+from .utils import CheckpointMismatchError, atomic_path, default_device, one_cpu_thread
 
 CHECKPOINT = "checkpoint.pt"
 
@@ -99,11 +99,18 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     ``checkpoint_every`` epochs and at the end (atomically); a later call with
     the same ``out_dir`` and profile resumes from it, and one whose training
     finished returns at once. ``callback(epoch, model, record)``, if given, is
-    called after every epoch (e.g. to evaluate along the way).
+    called after every epoch (e.g. to evaluate along the way). On the CPU it
+    trains on one thread (:func:`~pgae_lite.utils.one_cpu_thread`).
     """
+    device = torch.device(device) if device else default_device()
+    with one_cpu_thread(device):
+        return _train(dataset, profile, out_dir, device, progress, model, callback)
+
+
+def _train(dataset: PGAEDataset, profile: Profile | str | None, out_dir: str | Path | None,
+           device: torch.device, progress: bool, model: PGAE | None, callback) -> Trained:
     profile = profile if isinstance(profile, Profile) else get_profile(profile)
     cfg = profile.train
-    device = torch.device(device) if device else default_device()
     train_set = _training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     data = normaliser.tensors(train_set, device)

@@ -1,0 +1,109 @@
+"""Chapter 04's ablation exercises at the recipe, three seeds: the reference their solutions quote.
+
+    python benchmarks/ablations.py [--ablations concat no-both ...] [--seeds 0 1 2] [--threads 1]
+
+Each ablation changes one thing of the profile's recipe (``book``), exactly as its
+exercise's solution does, and trains PGAE on our simulated data (the
+chapter's data) once per seed; the recipe itself (``recipe``, the cached
+:func:`pgae_lite.pipeline.trained_pgae`) is the baseline, on the same seeds.
+Writes every model's Table 1 cells and training time to
+results/ablations.json, so a solution can say whether its effect exceeds the
+spread of the seeds.
+"""
+from __future__ import annotations
+
+import copy
+
+import torch
+from torch import nn
+
+from harness import Benchmark
+from pgae_lite import language
+from pgae_lite.config import get_profile
+from pgae_lite.evaluate import evaluate
+from pgae_lite.pgae import PGAE
+from pgae_lite.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.train import train
+
+#: ex-pgae-no-both: the signals without "repeat both" (describe, execute, repeat action, -, repeat language)
+NO_BOTH = (3 / 8, 3 / 8, 1 / 8, 0.0, 1 / 8)
+
+
+class ConcatBottleneck(nn.Module):
+    """ex-pgae-concat: h = tanh(W [f_action; f_language] + b) in place of the GMU (a constant gate)."""
+
+    def __init__(self, action_dim: int, language_dim: int, hidden_dim: int = 50):
+        super().__init__()
+        self.linear = nn.Linear(action_dim + language_dim, hidden_dim)
+
+    def forward(self, f_action, f_language):
+        h = torch.tanh(self.linear(torch.cat([f_action, f_language], dim=1)))
+        return h, torch.full_like(h, 0.5)
+
+
+def concat_model(profile):
+    model = PGAE(profile.model)
+    model.gmu = ConcatBottleneck(model.cfg.state_dim, model.cfg.state_dim, model.cfg.hidden)
+    return model
+
+
+def small_embeddings(profile):
+    model = PGAE(profile.model)
+    with torch.no_grad():       # ex-pgae-embedding: the authors' U(-0.1, 0.1) input weights
+        for rnn in (model.language_encoder.rnn, model.language_decoder.rnn):
+            rnn.input_weight.uniform_(-0.1, 0.1)
+    return model
+
+
+def peephole(profile):
+    profile = copy.deepcopy(profile)
+    profile.model.cell = "peephole"
+    return profile
+
+
+#: name -> (profile change, model builder) of each exercise's solution
+ABLATIONS = {
+    "concat": (None, concat_model),
+    "cells": (peephole, None),
+    "no-both": (lambda p: get_profile(p.name, seed=p.train.seed, signal_probs=NO_BOTH), None),
+    "per-batch": (lambda p: get_profile(p.name, seed=p.train.seed, signals_per_sample=False), None),
+    "embedding": (None, small_embeddings),
+    "weights": ("flat word weights", None),
+}
+
+
+def train_ablation(name: str, data, profile_name: str, seed: int):
+    change, build = ABLATIONS[name]
+    profile = get_profile(profile_name, seed=seed)
+    if callable(change):
+        profile = change(profile)
+    model = build(profile) if build else None
+    saved = dict(language.WORD_WEIGHTS)
+    if change == "flat word weights":             # ex-pgae-weights: every word weighs 1
+        language.WORD_WEIGHTS.update({w: 1.0 for w in language.WORD_WEIGHTS})
+    try:
+        return train(data, profile, model=model, progress=False)
+    finally:
+        language.WORD_WEIGHTS.update(saved)
+
+
+def main() -> None:
+    bench = Benchmark("ablations", __doc__, seeds=[0, 1, 2])
+    bench.parser.add_argument("--ablations", nargs="+", default=list(ABLATIONS), choices=list(ABLATIONS))
+    args = bench.parse()
+    data = simulated_dataset(args.profile, "cpu", progress=False)
+    runs = []
+    for name in ["recipe", *args.ablations]:
+        for seed in args.seeds:
+            trained = (trained_pgae("PGAE", args.profile, seed, device="cpu", progress=False) if name == "recipe"
+                       else train_ablation(name, data, args.profile, seed))
+            cells, _ = evaluate(trained.model, data, trained.normaliser)
+            runs.append({"ablation": name, "seed": seed, "train_seconds": round(trained.seconds, 1),
+                         "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}})
+            print(name, seed, {s: (round(c["accuracy"], 2), round(c["nrmse"], 3)) for s, c in cells.items()},
+                  flush=True)
+    bench.write({"data": "ours (simulated)", "runs": runs})
+
+
+if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
+    main()
