@@ -11,7 +11,9 @@ import math
 
 import pytest
 import torch
-from pgae_lite.exercises import (CheckResult, check_bottleneck, check_gmu,
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu,
                                  check_lstm_step, check_peephole_step, check_signal_probs)
 from pgae_lite.layers import GatedMultimodalUnit
 
@@ -150,7 +152,38 @@ def test_raising_bottleneck_forward_and_factory_fail():
     assert failed_with(check_bottleneck(raising), "factory(12, 9, 6) raised KeyError")
 
 
-# ------------------------------------------------------------------ signal probabilities
+# ------------------------------------------------------------------ colours and probabilities
+@pytest.mark.parametrize("rgba, phrases", [
+    ([math.nan, math.nan, math.nan, 1], ["must be finite numbers; got [nan, nan, nan, 1]"]),
+    ((0.98, math.inf, 0.05, 1.0), ["must be finite numbers"]),
+    (("0.98", 0.5, 0.05, 1.0), ["must be finite numbers; got ('0.98'"]),
+    (None, ["must be finite numbers; got None"]),
+    ("pink", ["must be finite numbers; got 'pink'"]),
+    ((0.98, 0.5, 1j, 1.0), ["must be finite numbers"]),
+    ((), ["an RGBA colour has 4 numbers; got 0"]),
+    ((0.98, 0.5, 0.05, 1.0, 1.0), ["an RGBA colour has 4 numbers; got 5"]),
+    ((0.98, -0.5, 0.05, 1.0), ["must lie in [0, 1]"]),
+])
+def test_colour_rejects_what_is_not_four_finite_numbers(rgba, phrases):
+    result = check_colour("pink", rgba)
+    assert failed_with(result, *phrases), result
+
+
+def test_colour_accepts_a_tensor():
+    assert check_colour("orange", torch.tensor(ORANGE))
+
+
+@settings(max_examples=60, deadline=None)
+@given(bad=st.one_of(st.sampled_from([math.nan, math.inf, -math.inf]),
+                     st.floats(max_value=-1e-9), st.floats(min_value=1 + 1e-9)),
+       at=st.integers(0, 3))
+def test_colour_with_any_non_finite_or_out_of_range_value_fails(bad, at):
+    rgba = list(ORANGE)
+    rgba[at] = bad
+    result = check_colour("orange", rgba)
+    assert not result and ("finite numbers" in str(result) or "[0, 1]" in str(result))
+
+
 @pytest.mark.parametrize("probs, drop, phrases", [
     (None, "repeat both", ["must be finite numbers; got None", "give 5 numbers"]),
     ((math.nan, 0.5, 0.25, 0, 0.25), "repeat both", ["must be finite numbers"]),
