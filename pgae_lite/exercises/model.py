@@ -9,6 +9,7 @@ also in chapter 05).
 """
 from __future__ import annotations
 
+import copy
 import itertools
 import math
 import re
@@ -26,7 +27,8 @@ from ..pgae import PGAE, count_parameters
 from ..signals import SIGNAL_PROBS, make_batch, sample_signals
 from ..toydata import toy_dataset
 from ..train import pgae_loss
-from .result import CheckResult, _build, _call, _compare, _diagnose, _pair, _shape
+from .result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
+                     _pair, _shape, _unchanged, _value_problem)
 
 LSTM_EQUATION = ("[i; j; f; o] = x W_x + h W_h + b, c_t = σ(f + 0.8 + p_f ⊙ c_{t-1}) ⊙ c_{t-1} "
                  "+ σ(i + p_i ⊙ c_{t-1}) ⊙ tanh(j), h_t = σ(o + p_o ⊙ c_t) ⊙ tanh(c_t)")
@@ -54,14 +56,17 @@ def _check_step(student: Callable, peepholes: bool, name: str, seed: int) -> Che
             p.copy_(torch.rand(p.shape, generator=gen) * 2 - 1)
     x, h, c = (torch.rand(5, n, generator=gen) * 2 - 1 for n in (3, 4, 4))
     result.note(f"inputs: x {tuple(x.shape)}, h and c {tuple(h.shape)}, cell = PeepholeLSTMCell(3, 4)")
-    copies = (x.clone(), h.clone(), c.clone())
-    out = _call(result, "your step", student, copies[0], (copies[1], copies[2]), cell)
-    if not _pair(result, out, "h, c"):
-        return result
-    if not all(torch.equal(a, b) for a, b in zip(copies, (x, h, c))):
-        result.fail("your step changed x, h or c in place", "compute new tensors (no +=, .mul_(), ...)")
     variant = partial(_step, x, h, c, cell, peepholes=peepholes)      # the reference, or a mistake
     ref = variant()
+    given = {"x": x.clone(), "h": h.clone(), "c": c.clone()}  # the student sees copies
+    given_cell = copy.deepcopy(cell)
+    state = (given["h"], given["c"])
+    out = _call(result, "your step", student, given["x"], state, given_cell)
+    if not _pair(result, out, "h, c", "your step", tuple(h.shape)):
+        return result
+    weights = {f"cell.{n}": p for n, p in cell.named_parameters()}
+    given.update((f"cell.{n}", p) for n, p in given_cell.named_parameters())
+    _unchanged(result, "your step", given, {"x": x, "h": h, "c": c, **weights})
     if all([_compare(result, n, g, e) for n, g, e in zip(("h_t", "c_t"), out, ref)]):
         if not peepholes:
             result.note("with p_i = p_f = p_o = 0 this is torch.nn.LSTMCell's step (gate order i, f, j, o "
@@ -116,11 +121,12 @@ def check_gmu(student: type | nn.Module | Callable, seed: int = 0) -> CheckResul
     with torch.no_grad():
         for p in ref.parameters():
             p.copy_(torch.rand(p.shape, generator=gen) - 0.5)
-    forward = lambda fa, fl: student(ref, fa, fl)  # noqa: E731 - the function form
+    given = copy.deepcopy(ref)                      # the student's function sees a copy
+    forward = lambda fa, fl: student(given, fa, fl)  # noqa: E731 - the function form
     if isinstance(student, nn.Module):
         student = type(student)
     if isinstance(student, type):
-        forward = _build(result, student, A, L, H, name=student.__name__)
+        forward = given = _build(result, student, A, L, H, name=student.__name__)
         if forward is None:
             return result
         expected = {k: tuple(v.shape) for k, v in ref.state_dict().items()}
@@ -131,14 +137,17 @@ def check_gmu(student: type | nn.Module | Callable, seed: int = 0) -> CheckResul
         forward.load_state_dict(ref.state_dict())
     f_act, f_lang = torch.randn(B, A, generator=gen) * 1.5, torch.randn(B, L, generator=gen) * 1.5
     result.note(f"inputs: f_action {tuple(f_act.shape)}, f_language {tuple(f_lang.shape)}, hidden {H}")
-    out = _call(result, "your GMU", forward, f_act, f_lang)
-    if not _pair(result, out, "h, z"):
-        return result
-    with torch.no_grad():
+    with torch.no_grad():                       # the reference first, on the originals
         a_raw, l_raw = ref.action_linear(f_act), ref.language_linear(f_lang)
         a_h, l_h = torch.tanh(a_raw), torch.tanh(l_raw)
         pre = ref.gate_linear(torch.cat([f_act, f_lang], 1))
         z, z_swapped = torch.sigmoid(pre), torch.sigmoid(ref.gate_linear(torch.cat([f_lang, f_act], 1)))
+    inputs = {"f_action": f_act.clone(), "f_language": f_lang.clone()}
+    out = _call(result, "your GMU", forward, *inputs.values())
+    if not _pair(result, out, "h, z", "your GMU", (B, H)):
+        return result
+    _unchanged(result, "your GMU", {**inputs, **given.state_dict()},
+               {"f_action": f_act, "f_language": f_lang, **ref.state_dict()})
     h = z * a_h + (1 - z) * l_h
     if not all([_compare(result, "h", out[0], h), _compare(result, "z", out[1], z)]):
         _diagnose(result, out, [
@@ -169,19 +178,26 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     module = _build(result, factory, A, L, H)
     if module is None:
         return result
+    f_act = torch.randn(B, A, generator=gen)
     out = _call(result, f"your module on f_action {(B, A)}, f_language {(B, L)}", module,
-                torch.randn(B, A, generator=gen), torch.randn(B, L, generator=gen))
-    if out is None:
+                f_act, torch.randn(B, L, generator=gen))
+    if out is RAISED:
         return result.note("forward(f_action, f_language) takes both; the language features have language_dim "
                            "numbers (in PGAE-BERT 384, not 400)")
-    if not _pair(result, out, "h, z"):
-        return result.note("without a gate, return a constant one, e.g. torch.full_like(h, 0.5)")
+    if not _pair(result, out, "h, z", "your module", (B, H)):
+        gate = "without a gate, return a constant one, e.g. torch.full_like(h, 0.5)"
+        return result if out is None else result.note(gate)
     for name, t in zip("hz", out):
         if not isinstance(t, torch.Tensor) or t.shape != (B, H):
             result.fail(f"{name} has {_shape(t)}; expected (batch, hidden) = {(B, H)}")
     if not result:
         return result
-    result.ok(f"alone: h and z of shape (batch, hidden) = {(B, H)}")
+    for name, t in zip("hz", out):  # NaN or inf fails; the PGAE below shows its effect
+        problem = _value_problem(t, f_act)
+        if problem:
+            result.fail(f"{name} {problem}")
+    if result:
+        result.ok(f"alone: finite h and z of shape (batch, hidden) = {(B, H)}")
     model = PGAE(ModelConfig(units=8, layers=2, hidden=H, cell=cell, joint_feedback="predicted"))
     sizes = (model.cfg.state_dim, model.language_encoder.output_dim, H)
     gmu = _build(result, factory, *sizes)
@@ -192,7 +208,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     batch = make_batch(Normaliser.fit(toy).tensors(toy), torch.arange(5), signal=torch.arange(5),  # one each
                        alternative=torch.arange(5) % 8)
     out = _call(result, "PGAE with it", lambda: model(batch, teacher_language=True))
-    if out is None:
+    if out is RAISED:
         return result
     loss = pgae_loss(out, batch, word_weights())[0]
     if not torch.isfinite(loss):
@@ -223,12 +239,19 @@ def check_signal_probs(probs: Sequence[float] | dict[str, float], drop: str | No
     :data:`~pgae_lite.language.SIGNALS`, or a dict by signal name (missing names count as 0).
     Train with them as ``get_profile(..., signal_probs=probs)`` (:class:`~pgae_lite.config.TrainConfig`)."""
     result = CheckResult(f"signal probabilities without {drop!r}" if drop else "signal probabilities")
+    if drop is not None and drop not in SIGNALS:
+        return result.fail(f"drop is {drop!r}; expected None or one of the signals: "
+                           f"{', '.join(SIGNALS)}")
     if isinstance(probs, dict):
-        if set(probs) - set(SIGNALS):
-            return result.fail(f"unknown signal name(s) {sorted(set(probs) - set(SIGNALS))}; "
+        unknown = sorted(set(probs) - set(SIGNALS), key=repr)
+        if unknown:
+            return result.fail(f"unknown signal name(s) {unknown}; "
                                f"the signals are: {', '.join(SIGNALS)}")
         probs = [probs.get(s, 0.0) for s in SIGNALS]
-    p = [float(v) for v in probs]
+    p = _numbers(result, probs, "the probabilities")
+    if p is None:
+        return result.note(f"give {len(SIGNALS)} numbers in the order {list(SIGNALS)}, "
+                           "or a dict by signal name")
     if len(p) != len(SIGNALS):
         return result.fail(f"{len(p)} probabilities; expected {len(SIGNALS)}, one per signal: {list(SIGNALS)}")
     if min(p) < 0:

@@ -7,6 +7,7 @@ failure line, never a traceback, and compare outputs with the reference.
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import dataclass, field
 from typing import Any, Callable, Sequence
 
@@ -45,30 +46,79 @@ class CheckResult:
     __repr__ = __str__
 
 
+RAISED = object()  # what _call returns when student code raised (failure recorded)
+
+
 def _call(result: CheckResult, what: str, fn: Callable, *args: Any) -> Any:
     """Run student code; an exception becomes a failure line, never a traceback."""
     try:
         return fn(*args)
     except Exception as error:  # noqa: BLE001 - an error in student code is a finding
         result.fail(f"{what} raised {type(error).__name__}: {error}")
-        return None
+        return RAISED
 
 
 def _shape(t: Any) -> str:
     return f"shape {tuple(t.shape)}" if isinstance(t, torch.Tensor) else f"type {type(t).__name__}"
 
 
-def _pair(result: CheckResult, out: Any, names: str) -> bool:
-    if out is None or (isinstance(out, (tuple, list)) and len(out) == 2):
-        return out is not None
-    result.fail(f"it should return the pair ({names}); got {type(out).__name__}")
+def _returned(out: Any) -> str:
+    """In words: None, one tensor of shape (5, 4), a list of 3 items."""
+    if out is None:
+        return "None"
+    if isinstance(out, torch.Tensor):
+        return f"one tensor of shape {tuple(out.shape)}"
+    if isinstance(out, (tuple, list)):
+        return f"a {type(out).__name__} of {len(out)} items"
+    return f"a {type(out).__name__}"
+
+
+def _pair(result: CheckResult, out: Any, names: str, who: str, shape: tuple) -> bool:
+    """Whether ``out`` is a pair; if not, a failure line says what it was instead."""
+    if out is RAISED:
+        return False
+    if isinstance(out, (tuple, list)) and len(out) == 2:
+        return True
+    stub = f"a stub returns None: end with return {names}" if out is None else None
+    result.fail(f"{who} returned {_returned(out)}; expected the pair ({names}), "
+                f"two tensors of shape {shape}", stub)
     return False
+
+
+def _value_problem(got: torch.Tensor, like: torch.Tensor) -> str | None:
+    """What is wrong with a tensor of the right shape (dtype, device, NaN, inf)."""
+    if got.dtype != like.dtype or got.device != like.device:
+        return (f"is a {got.dtype} tensor on {got.device}; expected {like.dtype} "
+                f"on {like.device}, as the inputs")
+    bad = ~torch.isfinite(got.detach())
+    if not bad.any():
+        return None
+    at = tuple(bad.nonzero()[0].tolist())
+    return (f"has {int(bad.sum())} NaN or infinite entries of {bad.numel()}; "
+            f"the first is at index {at}: {got[at].item()}")
+
+
+def _unchanged(result: CheckResult, who: str, given: dict[str, torch.Tensor],
+               kept: dict[str, torch.Tensor]) -> None:
+    """Fail, naming them, if student code changed its copies of ``kept`` in place."""
+    def same(a: Any, b: torch.Tensor) -> bool:
+        return (isinstance(a, torch.Tensor) and a.dtype == b.dtype
+                and a.device == b.device and torch.equal(a, b))
+    changed = [n for n, t in kept.items() if not same(given.get(n), t)]
+    if changed:
+        result.fail(f"{who} changed {', '.join(changed)} in place; the check compares "
+                    "with the reference computed on the unchanged originals",
+                    "compute new tensors (no +=, .mul_(), .copy_(), ...)")
 
 
 def _compare(result: CheckResult, name: str, got: Any, expected: torch.Tensor) -> bool:
     """One output against the reference: type, shape, then values (where, and by how much)."""
     if not isinstance(got, torch.Tensor) or got.shape != expected.shape:
         result.fail(f"{name} has {_shape(got)}; expected a tensor of shape {tuple(expected.shape)}")
+        return False
+    problem = _value_problem(got, expected)
+    if problem:
+        result.fail(f"{name} {problem}")
         return False
     diff = (got.detach().double() - expected.double()).abs().nan_to_num(math.inf)
     if diff.max() <= 1e-5:
@@ -89,12 +139,28 @@ def _diagnose(result: CheckResult, got: Sequence, mistakes: list[tuple[str, tupl
     result.note(f"diagnosis: {hint}" if hint else f"compare each term with the equation: {equation}")
 
 
-def _build(result: CheckResult, factory: Callable, *sizes: int, name: str = "factory") -> nn.Module | None:
+def _build(result: CheckResult, factory: Callable, *sizes: int,
+           name: str = "factory") -> nn.Module | None:
+    """The student's module, ``factory(*sizes)``, or None after a failure line."""
     module = _call(result, f"{name}{sizes}", factory, *sizes)
-    if module is None or isinstance(module, nn.Module):
-        return module
-    result.fail(f"{name}{sizes} returned a {type(module).__name__}", "return an nn.Module, so that it trains")
+    if isinstance(module, nn.Module) or module is RAISED:
+        return None if module is RAISED else module
+    result.fail(f"{name}{sizes} returned {_returned(module)}",
+                "return an nn.Module, so that it trains")
     return None
+
+
+def _numbers(result: CheckResult, values: Any, what: str) -> list[float] | None:
+    """``values`` as floats, or None after a failure line: not finite numbers."""
+    try:  # a string is no number here, though float("0.5") reads it: NaN, so it fails
+        numbers = [math.nan if isinstance(v, (str, bytes)) else float(v)
+                   for v in values]
+    except (TypeError, ValueError, OverflowError):
+        numbers = [math.nan]
+    if isinstance(values, (str, bytes)) or not all(map(math.isfinite, numbers)):
+        result.fail(f"{what} must be finite numbers; got {reprlib.repr(values)}")
+        return None
+    return numbers
 
 
 __all__ = ["CheckResult"]

@@ -9,7 +9,7 @@ from __future__ import annotations
 from typing import Sequence
 
 from ..language import COLOURS, SIGNALS, VOCABULARY
-from .result import CheckResult
+from .result import CheckResult, _numbers
 
 
 # ------------------------------------------------------------------ (f) vocabulary and colours
@@ -43,12 +43,15 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2) 
     apart from the other cubes and the table (some channel differs by ``min_difference`` or more)."""
     from ..sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
 
-    result, values = CheckResult(f"cube colour {name!r}"), [float(v) for v in rgba]
+    result = CheckResult(f"cube colour {name!r}")
     if not isinstance(name, str) or not name or name != name.lower() or " " in name:
         result.fail(f"{name!r} should be one lowercase word (a hyphen joins two, as in greenish-blue)")
     elif name in COLOURS:
         result.fail(f"{name!r} is already one of the six colours of the dataset")
-    if max(values) > 1 or min(values) < 0:
+    values = _numbers(result, rgba, "the RGBA values")
+    if values is None:
+        return result.note("an RGBA colour is 4 numbers in [0, 1], alpha 1.0 last")
+    if not all(0 <= v <= 1 for v in values):
         result.fail(f"the values must lie in [0, 1]; got {tuple(values)}",
                     "pybullet takes 0..1: divide 0..255 values by 255" if max(values) > 1 else None)
     if len(values) != 4:
