@@ -133,9 +133,10 @@ class PGAEDataset:
         except Exception as e:  # zip, zlib, missing keys: all mean a damaged or foreign file
             raise DataFormatError(f"{path}: not a readable PGAE dataset file ({type(e).__name__}: {e})") from None
         if fingerprint is not None and saved["fingerprint"] != fingerprint:
-            raise DataFormatError(f"{path}: made from other data or configs "
-                                  f"(fingerprint {saved['fingerprint']!r}, not "
-                                  f"{fingerprint!r})")
+            found = (f"fingerprint {saved['fingerprint']!r}" if saved["fingerprint"]
+                     else "saved without a fingerprint")
+            raise DataFormatError(f"{path}: made from other data or configs ({found}, "
+                                  f"expected {fingerprint!r})")
         stamp = np.array(saved["fingerprint"] or "")
         content = array_digest({**arrays, "fingerprint": stamp})
         checked = fingerprint is not None or saved["digest"] is not None

@@ -186,6 +186,19 @@ def test_a_features_file_is_checked_before_use(toy, tmp_path):
         PGAEDataset.load(path, fingerprint="abc")
 
 
+def test_a_bad_features_cache_is_computed_again(smoke_episodes, toy):
+    data = pipeline.simulated_dataset("smoke", progress=False)
+    [path] = pipeline.cache_dir().glob("features/*.npz")
+    replace(data, vision=np.full_like(data.vision, np.nan)).save(path)   # NaN, no stamp
+    with pytest.warns(UserWarning, match="saved without a fingerprint"):
+        again = pipeline.simulated_dataset("smoke", progress=False)
+    np.testing.assert_array_equal(again.vision, data.vision)
+    toy.save(path, fingerprint="another dataset's")
+    with pytest.warns(UserWarning, match="fingerprint \"another dataset's\""):
+        again = pipeline.simulated_dataset("smoke", progress=False)
+    np.testing.assert_array_equal(again.vision, data.vision)
+
+
 def test_a_damaged_cached_pgae_is_trained_again(toy_short, monkeypatch):
     # The toy dataset stands in for the simulated one, as in test_pipeline.
     monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
