@@ -36,7 +36,7 @@ from torch import nn
 from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
-from .utils import CheckpointMismatchError, atomic_path, default_device
+from .utils import CheckpointMismatchError, default_device, load_torch, save_torch
 
 HEIGHT, WIDTH = 120, 160
 COLOURS = ("red", "green", "blue")
@@ -268,18 +268,20 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
         r, g, b = per_channel.tolist()
         history.append({"iteration": it + 1, "loss": (r + g + b) / 3, "red": r, "green": g, "blue": b})
     model.eval()
-    if out_path is not None:
-        out_path = Path(out_path)
-        out_path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(out_path) as tmp:   # a crash never leaves half a file
-            torch.save({"model": model.state_dict(), "config": config.to_dict(), "data": data,
-                        "history": history, "seconds": time.perf_counter() - t0}, tmp)
+    if out_path is not None:                 # atomic: a crash never leaves half a file
+        save_torch({"model": model.state_dict(), "config": config.to_dict(),
+                    "data": data, "history": history,
+                    "seconds": time.perf_counter() - t0}, out_path)
     return model, history
 
 
 def load_cae(path: str | Path, device: torch.device | str | None = None) -> tuple[ChannelSeparatedCAE, dict]:
-    """A trained CAE (in eval mode) and its checkpoint's other contents (read with ``weights_only=True``)."""
-    ckpt = torch.load(path, map_location="cpu", weights_only=True)
+    """A trained CAE (in eval mode) and its checkpoint's other contents.
+
+    Read with ``weights_only=True``; a damaged or foreign file raises
+    :class:`~pgae_lite.utils.CorruptCheckpointError`.
+    """
+    ckpt = load_torch(path, ("model", "config", "data", "history"), "CAE checkpoint")
     model = ChannelSeparatedCAE(CAEConfig.from_dict(ckpt["config"]))
     model.load_state_dict(ckpt["model"])
     return model.to(device or default_device()).eval(), ckpt

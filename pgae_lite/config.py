@@ -117,6 +117,14 @@ class TrainConfig:
                              f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
         self.signal_probs = probs
         check_vision_scaling(self.vision_scaling)
+        for name in ("epochs", "batch_size", "checkpoint_every", "max_train_samples"):
+            value = getattr(self, name)
+            if name == "max_train_samples" and value is None:
+                continue
+            if isinstance(value, bool) or not hasattr(value, "__index__") or value < 1:
+                also = " or None (all)" if name == "max_train_samples" else ""
+                raise ValueError(f"TrainConfig {name} must be a whole number >= "
+                                 f"1{also}; got {value!r}")
 
 
 @dataclass(frozen=True)

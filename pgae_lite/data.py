@@ -22,7 +22,7 @@ import torch
 
 from .language import VOCABULARY
 from .patterns import MAX_STEPS, Pattern
-from .utils import atomic_write
+from .utils import array_digest, atomic_write
 
 JOINT_DIM = 5
 VISION_DIM = 30
@@ -75,36 +75,83 @@ class PGAEDataset:
         return PGAEDataset(**arrays, source=self.source, extras=self.extras)
 
     def split(self, name: str) -> "PGAEDataset":
-        """``"train"`` or ``"test"`` samples."""
+        """``"train"`` or ``"test"`` samples; :class:`DataFormatError` if none."""
         if name not in ("train", "test"):
             raise ValueError(f"unknown split {name!r}; the splits are: train, test")
-        return self.subset(self.is_test if name == "test" else ~self.is_test)
+        part = self.subset(self.is_test if name == "test" else ~self.is_test)
+        if not len(part):
+            other = "training" if name == "test" else "test"
+            raise DataFormatError(
+                f"{self.source or 'the dataset'} has no {name} samples (all "
+                f"{len(self)} are {other} samples); training needs training samples "
+                "and evaluation test samples")
+        return part
+
+    def check_finite(self) -> None:
+        """:class:`DataFormatError` naming the sample if a valid step is not finite."""
+        for name in ("joints", "vision", "vision_opposite"):
+            bad = ~np.isfinite(getattr(self, name)).all(-1) & self.mask     # (N, T)
+            if bad.any():
+                sample, step = np.argwhere(bad)[0]
+                raise DataFormatError(
+                    f"{self.source or 'dataset'}: sample {self.ids[sample]}, step "
+                    f"{step}: {name} holds NaN or infinity; every value must be a "
+                    "finite number")
 
     def joint_range(self) -> float:
         """Observed range (max - min) of joint values over valid steps: nRMSE's denominator."""
         valid = self.joints[self.mask]
         return float(valid.max() - valid.min())
 
-    def save(self, path: str | Path) -> None:
-        """Write every array to one ``.npz`` file, atomically (a temporary file, then a rename)."""
+    def save(self, path: str | Path, fingerprint: str = "") -> None:
+        """Write every array to one ``.npz`` file, atomically (temporary file, rename).
+
+        ``fingerprint`` (e.g. a digest of the configs that made the data) is stored
+        with a digest of the arrays; :meth:`load` can ask for both.
+        """
         path = Path(path)
         arrays = {k: getattr(self, k) for k in _ARRAYS}
+        digest = array_digest({**arrays, "fingerprint": np.array(fingerprint)})
         with atomic_write(path) as f:
-            np.savez_compressed(f, source=np.array(self.source), **arrays)
+            np.savez_compressed(f, source=np.array(self.source),
+                                digest=np.array(digest),
+                                fingerprint=np.array(fingerprint), **arrays)
 
     @classmethod
-    def load(cls, path: str | Path) -> "PGAEDataset":
-        """Read a file written by :meth:`save`; :class:`DataFormatError` if it is damaged."""
+    def load(cls, path: str | Path, fingerprint: str | None = None) -> "PGAEDataset":
+        """A file written by :meth:`save`; :class:`DataFormatError` if it is damaged.
+
+        With ``fingerprint``, the file must have been saved with that fingerprint
+        and its arrays must match the digest saved with them (a cache's check).
+        """
         try:
             with np.load(path, allow_pickle=False) as f:
                 arrays = {k: f[k] for k in _ARRAYS}
                 source = str(f["source"])
+                saved = {k: str(f[k]) if k in f else None
+                         for k in ("fingerprint", "digest")}
         except Exception as e:  # zip, zlib, missing keys: all mean a damaged or foreign file
             raise DataFormatError(f"{path}: not a readable PGAE dataset file ({type(e).__name__}: {e})") from None
+        if fingerprint is not None and saved["fingerprint"] != fingerprint:
+            found = (f"fingerprint {saved['fingerprint']!r}" if saved["fingerprint"]
+                     else "saved without a fingerprint")
+            raise DataFormatError(f"{path}: made from other data or configs ({found}, "
+                                  f"expected {fingerprint!r})")
+        stamp = np.array(saved["fingerprint"] or "")
+        content = array_digest({**arrays, "fingerprint": stamp})
+        checked = fingerprint is not None or saved["digest"] is not None
+        if checked and saved["digest"] != content:
+            raise DataFormatError(f"{path}: its arrays do not match the digest saved "
+                                  "with them")
         n = len(arrays["lengths"])
-        if any(len(a) != n for a in arrays.values()) or arrays["joints"].shape[1:] != (MAX_STEPS, JOINT_DIM):
+        widths = {"joints": JOINT_DIM, "vision": VISION_DIM,
+                  "vision_opposite": VISION_DIM}
+        if any(len(a) != n for a in arrays.values()) or any(
+                arrays[k].shape[1:] != (MAX_STEPS, w) for k, w in widths.items()):
             raise DataFormatError(f"{path}: arrays of inconsistent shapes")
-        return cls(**arrays, source=source)
+        data = cls(**arrays, source=source)
+        data.check_finite()
+        return data
 
 
 #: How visual features can be scaled to [-1, 1] (see :meth:`Normaliser.fit`).
@@ -164,16 +211,24 @@ class Normaliser:
         space gets about the same variance, then one min and max).
         """
         check_vision_scaling(vision_scaling)
+        data.check_finite()
         m = data.mask
         white = None
         if vision_scaling == "whiten":
             mean, W = whitening(data.vision[m])                                   # NICO's view, (30,), (30, 30)
             white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
 
-        def lo_hi(x: np.ndarray) -> tuple[float, float]:
-            return float(x[m].min()), float(x[m].max())
-        return cls(lo_hi(data.joints), lo_hi(_whiten(data.vision, white)),
-                   lo_hi(_whiten(data.vision_opposite, white)), white)
+        def lo_hi(name: str, x: np.ndarray) -> tuple[float, float]:
+            lo, hi = float(x[m].min()), float(x[m].max())
+            if not lo < hi:
+                raise DataFormatError(f"{data.source or 'dataset'}: {name} are "
+                                      f"constant ({lo:g}) in the training samples: "
+                                      "nothing to scale")
+            return lo, hi
+        return cls(lo_hi("joints", data.joints),
+                   lo_hi("visual features", _whiten(data.vision, white)),
+                   lo_hi("opposite views", _whiten(data.vision_opposite, white)),
+                   white)
 
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
         if self.whitening is None:

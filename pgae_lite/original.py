@@ -5,7 +5,10 @@ per sample and modality under ``target/{behavior,vision,vision_opp,language}_{tr
 with ``actions.txt`` and ``arrangements.txt`` (one line per pattern) beside
 ``target/``. :func:`load_original` reads them into a :class:`~pgae_lite.data.PGAEDataset`
 and raises :class:`~pgae_lite.data.DataFormatError` naming what was expected
-when anything is missing or malformed.
+when anything is missing or malformed: a file and its line for a short or long
+row, a value that is not a finite number or lies far outside the data's range,
+a language row that is not one-hot (:mod:`pgae_lite.validate_data`), and a
+``vocabulary.txt`` whose words differ from :data:`pgae_lite.language.VOCABULARY`.
 """
 from __future__ import annotations
 
@@ -15,21 +18,11 @@ import numpy as np
 
 from .data import DataFormatError, PGAEDataset
 from .language import VOCABULARY
-from .patterns import MAX_STEPS
+from .patterns import MAX_STEPS, Pattern
+from .validate_data import (JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range,
+                            check_vocabulary, read_rows)
 
 _SUBTREES = ("behavior", "vision", "vision_opp", "language")
-
-
-def _read_matrix(path: Path, width: int) -> np.ndarray:
-    if not path.is_file():
-        raise DataFormatError(f"missing file {path}: every sample needs the same file name in all sub-folders")
-    try:
-        values = np.array(path.read_text().split(), dtype=np.float32)
-    except ValueError as e:
-        raise DataFormatError(f"{path}: expected rows of {width} numbers ({e})") from None
-    if values.size == 0 or values.size % width:
-        raise DataFormatError(f"{path}: expected rows of {width} numbers, found {values.size} numbers")
-    return values.reshape(-1, width)
 
 
 def load_original(path: str | Path) -> PGAEDataset:
@@ -53,6 +46,7 @@ def load_original(path: str | Path) -> PGAEDataset:
             if not (target / f"{sub}_{split}").is_dir():
                 raise DataFormatError(f"missing folder {target / f'{sub}_{split}'}")
     pattern_info = _read_patterns(root)
+    check_vocabulary(root)
 
     rows: dict[str, list] = {k: [] for k in (
         "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
@@ -61,21 +55,27 @@ def load_original(path: str | Path) -> PGAEDataset:
         for date_dir in sorted((target / f"behavior_{split}").iterdir()):
             for f in sorted(date_dir.glob("target*.txt")):
                 rel = f"{date_dir.name}/{f.stem}"
-                joints = _read_matrix(f, 5)
+                joints = read_rows(f, 5)
+                check_range(f, joints, *JOINT_BOUNDS, "joint")
                 n = len(joints)
-                vision = _read_matrix(target / f"vision_{split}" / f"{rel}.txt", 30)
-                opposite = _read_matrix(target / f"vision_opp_{split}" / f"{rel}.txt", 30)
-                lang = _read_matrix(target / f"language_{split}" / f"{rel}.txt", len(VOCABULARY))
+                vision, opposite = (_read_vision(target / f"{v}_{split}" / f"{rel}.txt")
+                                    for v in ("vision", "vision_opp"))
+                lang_file = target / f"language_{split}" / f"{rel}.txt"
+                lang = read_rows(lang_file, len(VOCABULARY))
+                check_one_hot(lang_file, lang)
                 if len(vision) != n or len(opposite) != n or not 0 < n <= MAX_STEPS:
                     raise DataFormatError(
-                        f"{rel}: joints, vision and opposite vision must have the same number of steps "
-                        f"(<= {MAX_STEPS}); got {n}, {len(vision)}, {len(opposite)}")
+                        f"{f}: joints, vision and opposite vision must have the same "
+                        f"number of steps (<= {MAX_STEPS}); got {n}, {len(vision)}, "
+                        f"{len(opposite)}")
                 if lang.shape[0] != 40:
-                    raise DataFormatError(f"{rel}: language file must have 40 one-hot rows (8 x 5), got {lang.shape[0]}")
-                words = lang.argmax(1).reshape(8, 5)[:, 1:4]  # (8 alternatives, 3 words)
+                    raise DataFormatError(f"{lang_file}: a language file has 40 "
+                                          "one-hot rows (8 x 5), found "
+                                          f"{lang.shape[0]}")
                 pattern = int(f.stem.replace("target", ""))
                 if pattern not in pattern_info:
                     raise DataFormatError(f"{rel}: pattern {pattern} not listed in actions.txt")
+                words = _descriptions(lang_file, lang, pattern)
                 action, arrangement, split_name = pattern_info[pattern]
                 if split_name != split:
                     raise DataFormatError(f"{rel}: actions.txt puts pattern {pattern} in {split_name}, found in {split}")
@@ -95,6 +95,27 @@ def load_original(path: str | Path) -> PGAEDataset:
     order = np.argsort(rows["ids"], kind="stable")  # by date, then pattern: a fixed order
     arrays = {k: np.asarray(v)[order] for k, v in rows.items()}
     return PGAEDataset(**arrays, source=f"original:{root}")
+
+
+def _read_vision(path: Path) -> np.ndarray:
+    vision = read_rows(path, 30)
+    check_range(path, vision, -VISION_LIMIT, VISION_LIMIT, "visual feature")
+    return vision
+
+
+def _descriptions(path: Path, lang: np.ndarray, pattern: int) -> np.ndarray:
+    """The 8 descriptions (8, 3) in a language file's rows, checked with its pattern."""
+    tokens = lang.argmax(1).reshape(8, 5)        # (8 alternatives, <BOS> w w w <EOS>)
+    expected = Pattern.from_number(pattern).descriptions()                  # (8, 3)
+    wrong = (tokens[:, [0, 4]] != 0).any(1) | (tokens[:, 1:4] != expected).any(1)
+    if wrong.any():
+        k = int(np.argmax(wrong))
+        said, meant = (" ".join(VOCABULARY[i] for i in words)
+                       for words in (tokens[k], [0, *expected[k], 0]))
+        raise DataFormatError(f"{path}, rows {5 * k + 1}-{5 * k + 5}: description "
+                              f"{k + 1} reads {said!r}, expected {meant!r} for pattern "
+                              f"{pattern}")
+    return tokens[:, 1:4]
 
 
 def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:

@@ -22,7 +22,7 @@ from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, tra
 from .config import TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
 from .simdata import DatasetConfig, generate, to_dataset, training_frames
-from .utils import cache_dir, config_digest
+from .utils import CorruptCheckpointError, cache_dir, config_digest
 
 if TYPE_CHECKING:
     from .train import Trained
@@ -63,15 +63,15 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
     prof = get_profile(profile)
     data, cae_config = prof.data, prof.cae
     path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
-    if path.exists():
+    if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite
         try:
-            return PGAEDataset.load(path)
+            return PGAEDataset.load(path, fingerprint=path.stem)
         except DataFormatError as e:
             warnings.warn(f"{e}; computing the features again", stacklevel=2)
     model, _ = trained_cae(prof.name, device, progress, workers)
     dataset = to_dataset(data, lambda frames: extract_features(model, frames), progress)
     path.parent.mkdir(parents=True, exist_ok=True)
-    dataset.save(path)
+    dataset.save(path, fingerprint=path.stem)
     return dataset
 
 
@@ -87,7 +87,7 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     them it is the profile's recipe, the model every chapter and ``reproduce`` train.
     An interrupted training resumes from its last checkpoint.
     """
-    from .train import train
+    from .train import CHECKPOINT, load_checkpoint, train
 
     if training not in TRAININGS:
         raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
@@ -96,6 +96,13 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
     stem = _stem(prof.data, prof.cae)
     folder = cache_dir() / "pgae" / f"{stem}-{training}-{config_digest(prof.to_dict())}"
+    if (folder / CHECKPOINT).exists():
+        try:
+            load_checkpoint(folder / CHECKPOINT)
+        except CorruptCheckpointError as e:   # damaged: trained again, like the CAE
+            warnings.warn(f"cached model not used, training it again: {e}",
+                          stacklevel=2)
+            (folder / CHECKPOINT).unlink()
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 

@@ -16,8 +16,8 @@ generation config:
 Each file is written atomically (a temporary file, then a rename), so an
 interrupted run leaves only whole files; the next run records only what is
 missing. A file whose digest does not match the manifest (or, if it is not in
-the manifest yet, whose contents fail their own check) is reported and
-recorded again, never used.
+the manifest yet, whose contents fail their own check, or hold another
+episode than its name says) is reported and recorded again, never used.
 
 :func:`~pgae_lite.pipeline.simulated_dataset` turns the episodes into the same
 :class:`~pgae_lite.data.PGAEDataset` as the authors' loader produces, with
@@ -42,7 +42,8 @@ from tqdm.auto import tqdm
 from .data import PGAEDataset, from_recordings
 from .patterns import Pattern
 from .sim.record import Episode, SimConfig, record_episode
-from .utils import atomic_write, atomic_write_text, cache_dir, config_digest
+from .utils import (array_digest, atomic_write, atomic_write_text, cache_dir,
+                    config_digest)
 
 #: Bump when the simulator changes what it records: old caches are then not reused.
 GENERATOR_VERSION = 4
@@ -80,14 +81,6 @@ def episode_name(pattern: int, variation: int) -> str:
     return f"{pattern:03d}-{variation}"
 
 
-def _content_digest(arrays: dict[str, np.ndarray]) -> str:
-    h = hashlib.blake2b(digest_size=16)
-    for k in sorted(arrays):
-        h.update(k.encode())
-        h.update(np.ascontiguousarray(arrays[k]).tobytes())
-    return h.hexdigest()
-
-
 def file_digest(path: Path) -> str:
     """Digest of a file's bytes (the manifest's check)."""
     h = hashlib.blake2b(digest_size=16)
@@ -111,7 +104,7 @@ def save_episode(path: Path, ep: Episode) -> None:
     arrays = {"joints": ep.joints, "images": ep.images, "images_opposite": ep.images_opposite,
               "displacement": ep.displacement,
               "meta": np.array([ep.pattern, ep.variation, ep.seed, ep.attempts], dtype=np.int64)}
-    digest = _content_digest(arrays)
+    digest = array_digest(arrays)
     for view in ("images", "images_opposite"):
         arrays[view] = _to_differences(arrays[view])
     with atomic_write(path) as f:
@@ -128,13 +121,17 @@ def load_episode_file(path: Path) -> Episode:
             arrays[view] = _from_differences(arrays[view])
     except Exception as e:  # zip, zlib or format errors: all mean the same thing here
         raise CorruptEpisodeError(f"{path}: unreadable ({type(e).__name__}: {e})") from None
-    if _content_digest(arrays) != digest:
+    if array_digest(arrays) != digest:
         raise CorruptEpisodeError(f"{path}: contents do not match their digest")
     pattern, variation, seed, attempts = (int(x) for x in arrays["meta"])
     steps = Pattern.from_number(pattern).steps
     if (arrays["joints"].shape != (steps, 5) or arrays["images"].shape != (steps, *IMAGE_SHAPE)
             or arrays["images_opposite"].shape != (steps, *IMAGE_SHAPE)):
         raise CorruptEpisodeError(f"{path}: unexpected shapes {arrays['joints'].shape}, {arrays['images'].shape}")
+    if path.stem != episode_name(pattern, variation):   # e.g. copied over another
+        raise CorruptEpisodeError(f"{path}: holds episode "
+                                  f"{episode_name(pattern, variation)}, not the one "
+                                  "its name says")
     return Episode(pattern=pattern, variation=variation, seed=seed, attempts=attempts,
                    joints=arrays["joints"], images=arrays["images"],
                    images_opposite=arrays["images_opposite"], displacement=arrays["displacement"], valid=True)

@@ -26,9 +26,13 @@ from .data import JOINT_DIM, Normaliser, PGAEDataset
 from .language import SIGNALS, word_weights
 from .pgae import PGAE
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
-from .utils import CheckpointMismatchError, atomic_path, default_device, one_cpu_thread
+from .utils import (CheckpointMismatchError, default_device, folder_lock, load_torch,
+                    one_cpu_thread, save_torch)
 
 CHECKPOINT = "checkpoint.pt"
+#: What every checkpoint written by :func:`save_checkpoint` holds.
+CHECKPOINT_KEYS = ("model", "optimiser", "generator", "torch_rng", "epoch", "history",
+                   "profile", "normaliser", "seconds")
 
 
 def pgae_loss(out: dict[str, torch.Tensor], batch: SignalBatch, weights: torch.Tensor,
@@ -84,6 +88,10 @@ class DataMismatchError(ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
 
+class NonFiniteLossError(FloatingPointError):
+    """The training loss became NaN or infinite: the run stops, nothing is saved."""
+
+
 def _training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
     """The samples a training run learns from: the training split, or its first ``max_samples``."""
     train_set = dataset.split("train")
@@ -98,19 +106,28 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     With ``out_dir`` a checkpoint is written there every
     ``checkpoint_every`` epochs and at the end (atomically); a later call with
     the same ``out_dir`` and profile resumes from it, and one whose training
-    finished returns at once. ``callback(epoch, model, record)``, if given, is
-    called after every epoch (e.g. to evaluate along the way). On the CPU it
+    finished returns at once. While it runs, a lock file in ``out_dir`` makes a
+    second run there fail (:class:`~pgae_lite.utils.FolderBusyError`).
+    ``callback(epoch, model, record)``, if given, is called after every epoch
+    (e.g. to evaluate along the way). A NaN or infinite loss stops the run
+    (:class:`NonFiniteLossError`, naming the epoch and the batch). On the CPU it
     trains on one thread (:func:`~pgae_lite.utils.one_cpu_thread`).
     """
     device = torch.device(device) if device else default_device()
+    args = (dataset, profile, out_dir, device, progress, model, callback)
     with one_cpu_thread(device):
-        return _train(dataset, profile, out_dir, device, progress, model, callback)
+        if out_dir is None:
+            return _train(*args)
+        with folder_lock(out_dir):
+            return _train(*args)
 
 
-def _train(dataset: PGAEDataset, profile: Profile | str | None, out_dir: str | Path | None,
-           device: torch.device, progress: bool, model: PGAE | None, callback) -> Trained:
+def _train(dataset: PGAEDataset, profile: Profile | str | None,
+           out_dir: str | Path | None, device: torch.device,
+           progress: bool, model: PGAE | None, callback) -> Trained:
     profile = profile if isinstance(profile, Profile) else get_profile(profile)
     cfg = profile.train
+    cfg.__post_init__()              # checked again: a field may have been set since
     train_set = _training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     data = normaliser.tensors(train_set, device)
@@ -171,7 +188,10 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None, out_dir: str | P
             if cfg.clip:
                 nn.utils.clip_grad_norm_(model.parameters(), cfg.clip)
             optimiser.step()
-            sums += torch.tensor([loss.item(), lang.item(), act.item()]) * size
+            losses = torch.tensor([loss.item(), lang.item(), act.item()])
+            if not torch.isfinite(losses).all():
+                _stop(losses, epoch, b, batches, signal)
+            sums += losses * size
             z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
             gate_sum.index_add_(0, signal, z)
             gate_n.index_add_(0, signal, torch.ones(size))
@@ -192,21 +212,38 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None, out_dir: str | P
     return Trained(model, normaliser, history, profile, time.perf_counter() - t0)
 
 
+def _stop(losses: torch.Tensor, epoch: int, batch: int, batches: int,
+          signal: torch.Tensor) -> None:
+    """Raise :class:`NonFiniteLossError` for a batch whose loss is NaN or infinite."""
+    total, lang, act = losses.tolist()
+    signals = ", ".join(SIGNALS[i] for i in sorted(set(signal.tolist())))
+    raise NonFiniteLossError(
+        f"training stopped: the loss is {total} (language {lang}, action {act}) at "
+        f"epoch {epoch + 1}, batch {batch + 1} of {batches} (signals {signals}); look "
+        "for extreme values in the data, or lower the learning rate")
+
+
 def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, gen: torch.Generator,
                     epoch: int, history: list[dict], profile: Profile, normaliser: Normaliser,
                     seconds: float) -> None:
-    """Write a checkpoint atomically (a crash mid-write never leaves a broken file)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        torch.save({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
-                    "generator": gen.get_state(), "torch_rng": torch.get_rng_state(), "epoch": epoch,
-                    "history": history, "profile": profile.to_dict(),
-                    "normaliser": normaliser.state_dict(), "seconds": seconds}, tmp)
+    """Write a checkpoint atomically (a crash mid-write never leaves a broken file).
+
+    A write that fails (a full disk, a read-only folder) raises
+    :class:`~pgae_lite.utils.OutputError` naming the file; the old checkpoint stays.
+    """
+    save_torch({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
+                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(),
+                "epoch": epoch, "history": history, "profile": profile.to_dict(),
+                "normaliser": normaliser.state_dict(), "seconds": seconds}, path)
 
 
 def load_checkpoint(path: str | Path) -> dict:
-    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only)."""
-    return torch.load(path, map_location="cpu", weights_only=True)
+    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only).
+
+    An empty, truncated or foreign file raises
+    :class:`~pgae_lite.utils.CorruptCheckpointError` naming it.
+    """
+    return load_torch(path, CHECKPOINT_KEYS)
 
 
 def _same_numbers(a: list, b: list) -> bool:
@@ -240,7 +277,7 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
     another CAE's features produces nonsense without any error, so this
     raises :class:`DataMismatchError` instead.
     """
-    ckpt = load_checkpoint(path)
+    ckpt = load_torch(path, ("model", "profile", "normaliser"))
     if dataset is not None:
         cfg = ckpt["profile"]["train"]
         fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
@@ -254,5 +291,6 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["train", "pgae_loss", "DataMismatchError", "Trained", "load_model", "load_checkpoint",
+__all__ = ["train", "pgae_loss", "DataMismatchError", "NonFiniteLossError",
+           "Trained", "load_model", "load_checkpoint",
            "save_checkpoint", "lr_factor"]

@@ -10,18 +10,29 @@ What several modules need and none of them owns. It imports nothing from
   is written under a temporary name beside its place, then renamed onto it in
   one step, so a reader (or a crash) never meets half a file;
 - :func:`config_digest`: the short digest of a config that names its cache entry;
+  :func:`array_digest`: a digest of arrays' contents (a cache file's check);
+- :func:`save_torch`, :func:`load_torch`: checkpoints written atomically and read
+  with ``weights_only=True``; a write that fails (a full disk, a read-only
+  folder) raises :class:`OutputError`, a damaged or unsafe file
+  :class:`CorruptCheckpointError`, each one sentence naming the file;
+- :func:`folder_lock`: one training run at a time in an output folder;
 - :class:`CheckpointMismatchError`: a file holds the work of another recipe.
 """
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
+import pickle
+import shutil
+import socket
 import uuid
 from pathlib import Path
 from typing import IO, Iterator
 
+import numpy as np
 import torch
 
 CACHE_ENV = "PGAE_LITE_CACHE"
@@ -29,6 +40,18 @@ CACHE_ENV = "PGAE_LITE_CACHE"
 
 class CheckpointMismatchError(ValueError):
     """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
+
+
+class CorruptCheckpointError(ValueError):
+    """A checkpoint is empty, truncated, foreign, or holds more than tensors, data."""
+
+
+class OutputError(OSError):
+    """A file or folder cannot be written (full disk, read-only, a file in the way)."""
+
+
+class FolderBusyError(RuntimeError):
+    """Another live process is training into the same output folder."""
 
 
 def cache_dir() -> Path:
@@ -67,6 +90,44 @@ def config_digest(obj) -> str:
     return hashlib.sha1(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()[:12]
 
 
+def array_digest(arrays: dict[str, np.ndarray]) -> str:
+    """32 hex digits of a BLAKE2b over the names and bytes of ``arrays``."""
+    h = hashlib.blake2b(digest_size=16)
+    for k in sorted(arrays):
+        h.update(k.encode())
+        h.update(np.ascontiguousarray(arrays[k]).tobytes())
+    return h.hexdigest()
+
+
+def _why(path: Path, error: BaseException) -> str:
+    """Why a write to ``path`` failed, in words: a full disk said as such."""
+    try:
+        free = shutil.disk_usage(path.parent).free
+    except OSError:
+        free = None
+    full = free is not None and free < 1 << 24                  # under 16 MiB left
+    if getattr(error, "errno", None) == errno.ENOSPC or full:
+        return f"the disk is full ({free} bytes free)"
+    if isinstance(error, OSError) and error.strerror:
+        return error.strerror
+    text = str(error).strip()
+    return text.splitlines()[0] if text else type(error).__name__
+
+
+def make_folder(folder: str | Path) -> Path:
+    """``mkdir -p`` that fails with one clear sentence (:class:`OutputError`)."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise OutputError(f"cannot use {folder} as an output folder: a file of that "
+                          "name is in the way") from None
+    except OSError as e:
+        raise OutputError(f"cannot create the output folder {folder}: "
+                          f"{_why(folder, e)}") from None
+    return folder
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; it replaces ``path`` when the block ends.
@@ -77,12 +138,20 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     name holds the process id and a random part: parallel writers never share one.
     """
     path = Path(path)
+    if path.is_dir():
+        raise OutputError(f"cannot write {path}: it is a folder; name a file")
     tmp = path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp")
     try:
         yield tmp
         os.replace(tmp, path)
+    except OutputError:
+        raise
+    except OSError as e:        # full disk, read-only folder, a file for a folder
+        raise OutputError(f"cannot write {path}: {_why(path, e)}; the old file, if "
+                          "any, is unchanged") from None
     finally:
-        tmp.unlink(missing_ok=True)     # only left if the block (or the rename) failed
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)     # only left if the block (or rename) failed
 
 
 @contextlib.contextmanager
@@ -98,5 +167,117 @@ def atomic_write_text(path: str | Path, text: str, encoding: str = "utf-8") -> N
         f.write(text)
 
 
-__all__ = ["CACHE_ENV", "CheckpointMismatchError", "atomic_path", "atomic_write", "atomic_write_text",
-           "cache_dir", "config_digest", "default_device"]
+def save_torch(obj, path: str | Path) -> None:
+    """``torch.save(obj, path)``, atomically; :class:`OutputError` if it fails."""
+    path = Path(path)
+    make_folder(path.parent)
+    with atomic_path(path) as tmp:
+        try:
+            torch.save(obj, tmp)
+        except RuntimeError as e:   # torch: "enforce fail at inline_container.cc"
+            raise OutputError(f"cannot write {path}: {_why(path, e)}; the old file, if "
+                              "any, is unchanged") from None
+
+
+def load_torch(path: str | Path, keys: tuple[str, ...] = (),
+               what: str = "checkpoint") -> dict:
+    """A dict saved by :func:`save_torch`, read with ``weights_only=True``.
+
+    Raises :class:`CorruptCheckpointError` naming the file if it is empty,
+    truncated, not a torch file, holds other Python objects than tensors and
+    plain data (never loaded: unpickling them can run code), or lacks ``keys``.
+    """
+    path = Path(path)
+    if not path.is_file():
+        folder = " (it is a folder)" if path.is_dir() else ""
+        raise FileNotFoundError(f"no {what} at {path}{folder}")
+    try:
+        obj = torch.load(path, map_location="cpu", weights_only=True)
+    except pickle.UnpicklingError as e:
+        if "GLOBAL" in str(e):       # a class or function to import: refused
+            raise CorruptCheckpointError(
+                f"{path} holds Python objects other than tensors and plain data, so "
+                f"it is not a pgae_lite {what}; weights_only=True refuses it, since "
+                "unpickling it could run code") from None
+        raise CorruptCheckpointError(f"{path} is not a readable {what} (not a "
+                                     "torch file)") from None
+    except Exception as e:  # EOFError (empty), RuntimeError (truncated zip), KeyError
+        why = "empty" if path.stat().st_size == 0 else "truncated or damaged"
+        raise CorruptCheckpointError(f"{path} is not a readable {what}: it is {why} "
+                                     f"({type(e).__name__}); delete it to start "
+                                     "again") from None
+    missing = [k for k in keys if not isinstance(obj, dict) or k not in obj]
+    if missing:
+        raise CorruptCheckpointError(f"{path} is not a pgae_lite {what}: it lacks "
+                                     f"{', '.join(missing)}")
+    return obj
+
+
+LOCK_FILE = ".pgae_lite.lock"
+
+
+def _holder(lock: Path) -> str | None:
+    """``host:pid`` of a lock's live holder; None if the lock is stale (or gone)."""
+    try:
+        host, _, pid = lock.read_text().strip().rpartition(":")
+    except OSError:
+        return None
+    if host != socket.gethostname():
+        return f"{host}:{pid}"        # another machine's process: it cannot be checked
+    if not pid.isdigit() or int(pid) == os.getpid():
+        return None                   # unreadable, or left by this very process
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return None
+    except PermissionError:
+        pass                          # alive, another user's
+    return f"{host}:{pid}"
+
+
+@contextlib.contextmanager
+def folder_lock(folder: str | Path) -> Iterator[None]:
+    """Hold ``folder``'s lock file while the block runs: a second run there fails.
+
+    The lock file holds ``host:pid``; a lock whose process has died is taken over.
+    """
+    lock = make_folder(folder) / LOCK_FILE
+    token = f"{socket.gethostname()}:{os.getpid()}"
+    mine = lock.with_name(f"{LOCK_FILE}.{os.getpid()}-{uuid.uuid4().hex[:8]}")
+    try:
+        mine.write_text(token)
+        while True:
+            try:
+                os.link(mine, lock)              # atomic: fails if a lock is there
+                break
+            except FileExistsError:
+                holder = _holder(lock)
+                if holder is not None:
+                    raise FolderBusyError(
+                        f"{folder} is in use by another run (process {holder}, lock "
+                        f"file {lock}); wait for it, use another folder, or delete the "
+                        "lock file if that process is gone") from None
+                stale = lock.with_name(f"{mine.name}.stale")
+                with contextlib.suppress(FileNotFoundError):
+                    os.replace(lock, stale)      # one taker wins; the others retry
+                    stale.unlink()
+    except OSError as e:
+        mine.unlink(missing_ok=True)
+        raise OutputError(f"cannot write the lock file {lock}: "
+                          f"{_why(lock, e)}") from None
+    except BaseException:
+        mine.unlink(missing_ok=True)
+        raise
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            if lock.read_text() == token:
+                lock.unlink()
+        mine.unlink(missing_ok=True)
+
+
+__all__ = ["CACHE_ENV", "CheckpointMismatchError", "CorruptCheckpointError",
+           "FolderBusyError", "OutputError", "array_digest", "atomic_path",
+           "atomic_write", "atomic_write_text", "cache_dir", "config_digest",
+           "default_device", "folder_lock", "load_torch", "make_folder", "save_torch"]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from pgae_lite.data import DataFormatError
-from pgae_lite.language import VOCABULARY
+from pgae_lite.language import SIGNALS, VOCABULARY
 from pgae_lite.original import load_original
 from pgae_lite.patterns import Pattern
 
@@ -56,6 +56,8 @@ def _fake_tree(dest: Path, numbers=(0, 2), date="201207") -> Path:
     (root / "actions.txt").write_text("".join(
         f"{p.code:<23}{'test' if p.is_test else 'train'}\n" for p in patterns))
     (root / "arrangements.txt").write_text("".join(f"{p.left}+{p.right}\n" for p in patterns))
+    words = [*VOCABULARY, *(f"{s}:" for s in SIGNALS)]
+    (root / "vocabulary.txt").write_text("\n".join(words))
     for sub in SUBTREES:
         for split in ("train", "test"):
             (root / "target" / f"{sub}_{split}" / date).mkdir(parents=True)
@@ -92,7 +94,7 @@ def test_fake_tree_has_the_authors_format(original_data, tmp_path):
         for sub in SUBTREES[:3]:
             real = np.loadtxt(original_data / "target" / f"{sub}_{split}" / name)
             assert real.shape == np.loadtxt(root / "target" / f"{sub}_{split}" / name).shape
-    for name in ("actions.txt", "arrangements.txt"):
+    for name in ("actions.txt", "arrangements.txt", "vocabulary.txt"):
         real = [line.split() for line in (original_data / name).read_text().splitlines() if line.strip()]
         assert real == [line.split() for line in (root / name).read_text().splitlines()]
 
