@@ -201,3 +201,11 @@ def test_the_reference_solutions_still_pass():
     """The new checks reject nothing the book's reference solutions do."""
     assert check_peephole_step(package_step) and check_gmu(gmu_forward)
     assert check_gmu(GatedMultimodalUnit) and check_bottleneck(GatedMultimodalUnit)
+
+
+@pytest.mark.parametrize("words", [None, "red", [3, "red"], [["red"]], {"red": 1}])
+def test_check_vocabulary_refuses_what_is_not_a_list_of_words(words):
+    from pgae_lite.exercises import check_vocabulary
+
+    result = check_vocabulary(words)
+    assert not result and "list of strings" in str(result)

@@ -6,7 +6,8 @@ colours (chapters 01, 02 and 03). Each check returns a
 """
 from __future__ import annotations
 
-from typing import Sequence
+import reprlib
+from collections.abc import Sequence
 
 from ..language import COLOURS, SIGNALS, VOCABULARY
 from .result import CheckResult, _numbers
@@ -15,7 +16,14 @@ from .result import CheckResult, _numbers
 # ------------------------------------------------------------------ (f) vocabulary and colours
 def check_vocabulary(words: Sequence[str], new: Sequence[str] = ()) -> CheckResult:
     """(f) An extended vocabulary: the 23 words in their order, then the new ones (``new``, if given)."""
-    result, words = CheckResult("extended vocabulary"), list(words)
+    result = CheckResult("extended vocabulary")
+    for name, given in (("words", words), ("new", new)):
+        if (isinstance(given, (str, bytes)) or not isinstance(given, Sequence)
+                or not all(isinstance(w, str) for w in given)):
+            result.fail(f"{name} must be a list of strings; got {reprlib.repr(given)}",
+                        "e.g. list(VOCABULARY) + ['orange', 'amber']")
+            return result
+    words = list(words)
     k = next((k for k, w in enumerate(VOCABULARY) if k >= len(words) or words[k] != w), None)
     if k is not None:
         result.fail(f"position {k} holds {words[k] if k < len(words) else 'nothing'!r}; expected {VOCABULARY[k]!r}",
