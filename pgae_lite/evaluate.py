@@ -133,7 +133,8 @@ def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str 
     check_model_inputs(model, data, normaliser)
     if joint_range is None:
         joint_range = data.joint_range()
-    joint_range = positive_number("joint_range", joint_range)
+    else:
+        joint_range = positive_number("joint_range", joint_range)
     subset = data.split(split)
     tensors = normaliser.tensors(subset, next(model.parameters()).device)
     results, preds = {}, {}
