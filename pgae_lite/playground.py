@@ -50,8 +50,8 @@ from .signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from .sim.record import Execution
 from .simdata import DatasetConfig
 from .validate_api import instance_of, positive_number, whole_number
-from .validate_playground import (action_number, arrangement_number, check_objects,
-                                  check_playground)
+from .validate_playground import (LAST_PATTERN, action_number, arrangement_number,
+                                  check_objects, check_playground)
 from .viz import animate_frames, plot_joints
 
 #: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
@@ -93,7 +93,7 @@ def simulator_config(data: PGAEDataset) -> DatasetConfig:
 def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[int, int]:
     """(row in ``data``, simulator variation) of the ``variation``-th recording of ``pattern``."""
     instance_of("data", data, PGAEDataset, "a PGAEDataset")
-    pattern = whole_number("pattern", pattern, 0, 143)
+    pattern = whole_number("pattern", pattern, 0, LAST_PATTERN)
     variation = whole_number("variation", variation, 0)
     rows = np.flatnonzero(data.pattern == pattern)
     if variation >= len(rows):

@@ -18,6 +18,8 @@ from .simdata import DatasetConfig
 from .validate_api import instance_of, shown, whole_number
 
 SPEEDS = 2   # 0 slowly, 1 fast
+#: The last pattern number (143): speed, arrangement and action at their largest.
+LAST_PATTERN = SPEEDS * len(ARRANGEMENTS) * len(ACTION_SIDES) - 1
 
 
 def arrangement_number(arrangement) -> int:
@@ -61,5 +63,5 @@ def check_playground(models, cae, data, config, every, signal, arrangement, acti
     action_number(action)
 
 
-__all__ = ["SPEEDS", "action_number", "arrangement_number", "check_objects",
-           "check_playground"]
+__all__ = ["LAST_PATTERN", "SPEEDS", "action_number", "arrangement_number",
+           "check_objects", "check_playground"]

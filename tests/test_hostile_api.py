@@ -8,6 +8,7 @@ description parser and ``encode``/``decode`` on valid and on arbitrary input.
 """
 from __future__ import annotations
 
+import functools
 import importlib
 import inspect
 import json
@@ -34,11 +35,14 @@ from pgae_lite.playground import (PlayResult, Playground, action_label,
                                   arrangement_label, find_episode, pattern_number, play,
                                   simulator_config)
 from pgae_lite.pretrained import PretrainedLanguageEncoder, load_transformer
+from pgae_lite.patterns import ARRANGEMENTS
 from pgae_lite.reproduce import reproduce, write_results
+from pgae_lite.validate_playground import LAST_PATTERN
 from test_cli import run as run_cli
 
 WORDS = [w for w in VOCABULARY if w != BOS_EOS]
 ARRANGEMENT, ACTION = 7, 8          # cyan left, yellow right; slide the left cube fast
+LAST_WORD, LAST_ARRANGEMENT = len(VOCABULARY) - 1, len(ARRANGEMENTS) - 1     # 22, 11
 
 
 def refused(r, *needles):
@@ -184,7 +188,7 @@ def test_encode_names_the_bad_word():
     (7, "0-D"),
 ])
 def test_decode_refuses_malformed_input(indices, message):
-    wanted = r"decode takes word indices \(whole numbers 0-22\).*"
+    wanted = rf"decode takes word indices \(whole numbers 0-{LAST_WORD}\).*"
     with pytest.raises(LanguageError, match=wanted + message):
         decode(indices)
 
@@ -258,7 +262,7 @@ def test_encode_accepts_or_says_why(words):
 
 anything = st.recursive(st.one_of(st.integers(), st.floats(), st.booleans(), st.none(),
                                   st.text(max_size=5)),
-                        lambda inner: st.lists(inner, max_size=5), max_leaves=12)
+                        functools.partial(st.lists, max_size=5), max_leaves=12)
 
 
 @given(anything)
@@ -277,7 +281,7 @@ def test_decode_reads_exactly_the_indices_0_to_22(indices):
         words = indices[:(indices + [0]).index(0)]             # up to the first <EOS>
         assert decode(indices) == " ".join(VOCABULARY[i] for i in words)
     else:
-        with pytest.raises(LanguageError, match="whole numbers 0-22"):
+        with pytest.raises(LanguageError, match=f"whole numbers 0-{LAST_WORD}"):
             decode(indices)
 
 
@@ -310,10 +314,12 @@ def test_evaluation_checks_its_arguments(tiny, toy):
 # ------------------------------------------------------------------- playground
 def test_play_refuses_choices_out_of_range(tiny, toy):
     model, normaliser = tiny
-    numbers = "must be a whole number from 0 to 11; got"
-    with pytest.raises(ArgumentError, match=f"arrangement {numbers} 12"):
-        play(model, None, normaliser, toy, "execute", 12, 0, loop=None)  # was: 72
-    with pytest.raises(ArgumentError, match=f"action {numbers} -1"):
+    beyond = LAST_ARRANGEMENT + 1
+    with pytest.raises(ArgumentError, match=f"arrangement must be a whole number from "
+                                            f"0 to {LAST_ARRANGEMENT}; got {beyond}"):
+        play(model, None, normaliser, toy, "execute", beyond, 0, loop=None)  # was: 72
+    with pytest.raises(ArgumentError, match="action must be a whole number from 0 to "
+                                            "11; got -1"):
         play(model, None, normaliser, toy, "execute", 0, -1, loop=None)
     with pytest.raises(ArgumentError, match="variation must be .* >= 0; got -1"):
         play(model, None, normaliser, toy, "execute", 0, 0, variation=-1,
@@ -335,11 +341,13 @@ def test_play_refuses_choices_that_are_not_whole_numbers(tiny, toy, argument, va
 
 def test_every_public_playground_function_checks_its_arguments(tiny, toy):
     model, normaliser = tiny
+    beyond = LAST_ARRANGEMENT + 1
     checks = [
-        (lambda: arrangement_label(-1), ArgumentError, "arrangement .* 11; got -1"),
+        (lambda: arrangement_label(-1), ArgumentError, "arrangement .* got -1"),
         (lambda: action_label(12), ArgumentError, "action .* 0 to 11; got 12"),
         (lambda: pattern_number(0, 2.0), ArgumentTypeError, "action must be a whole"),
-        (lambda: find_episode(toy, 144), ArgumentError, "pattern .* 0 to 143; got 144"),
+        (lambda: find_episode(toy, LAST_PATTERN + 1), ArgumentError,
+         f"pattern .* 0 to {LAST_PATTERN}; got {LAST_PATTERN + 1}"),
         (lambda: simulator_config("data"), ArgumentTypeError, "data must be a PGAE"),
         (lambda: play("model", None, normaliser, toy), ArgumentTypeError,
          "model must be a model"),
@@ -350,8 +358,8 @@ def test_every_public_playground_function_checks_its_arguments(tiny, toy):
         (lambda: Playground({}, None, toy), ArgumentError, "models is empty"),
         (lambda: Playground({"PGAE": model}, None, toy), ArgumentTypeError,
          r"models\['PGAE'\] must be a \(model, normaliser\) pair; got a PGAE"),
-        (lambda: Playground({"PGAE": tiny}, None, toy, arrangement=12), ArgumentError,
-         "arrangement must be .* 0 to 11; got 12"),
+        (lambda: Playground({"PGAE": tiny}, None, toy, arrangement=beyond),
+         ArgumentError, f"arrangement must be .* got {beyond}"),
         (lambda: Playground({"PGAE": tiny}, None, toy.subset(np.arange(6)),
                             arrangement=7),
          ArgumentError, "arrangement 7 is not in this dataset; its arrangements are"),
