@@ -27,6 +27,8 @@ Modules, in the order the book introduces them:
 - ``exercises``   check functions: a student's code against the package's, and what is wrong (by chapter)
 - ``viz``         plots and animations for the chapters (by topic: scenes, vision, model, embeddings)
 - ``utils``       plumbing: the cache folder, the device, atomic writes, config digests
+- ``errors``      the package's errors, each a ``PGAELiteError`` (the CLI prints them)
+- ``validate_api``, ``validate_playground``: argument checks of the public functions
 
 Command line: ``python -m pgae_lite --help`` (simulate, reproduce).
 """

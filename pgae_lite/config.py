@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 from .cae import CAEConfig
 from .data import check_vision_scaling
+from .errors import ArgumentError
 from .language import SIGNALS
 from .patterns import pattern_number
 from .signals import SIGNAL_PROBS
@@ -186,15 +187,17 @@ PROFILES: dict[str, Profile] = {
 def profile_name(name: str | None = None) -> str:
     """``name``, else ``$PGAE_LITE_PROFILE``, else ``"book"``: the name of a built-in profile.
 
-    The only code that reads the environment variable. An unknown name raises a
-    :class:`ValueError` that lists the profiles (and names the variable if it came from there).
+    The only code that reads the environment variable. An unknown name (or not a string)
+    raises an :class:`~pgae_lite.errors.ArgumentError` (a ``ValueError``) that lists the
+    profiles (and names the variable if it came from there).
     """
     where = ""
-    if not name:
+    if name is None or name == "":
         name = os.environ.get(PROFILE_ENV, "book")
         where = f" (from the environment variable {PROFILE_ENV})" if PROFILE_ENV in os.environ else ""
-    if name not in PROFILE_NAMES:
-        raise ValueError(f"unknown profile {name!r}{where}; the profiles are: {', '.join(PROFILE_NAMES)}")
+    if not isinstance(name, str) or name not in PROFILE_NAMES:
+        raise ArgumentError(f"unknown profile {name!r}{where}; the profiles are: "
+                            f"{', '.join(PROFILE_NAMES)}")
     return name
 
 
@@ -206,7 +209,8 @@ def get_profile(name: str | None = None, **train_overrides) -> Profile:
     p = PROFILES[profile_name(name)]
     bad = set(train_overrides) - set(asdict(p.train))
     if bad:
-        raise ValueError(f"unknown training option(s) {sorted(bad)}; the options are: {', '.join(asdict(p.train))}")
+        raise ArgumentError(f"unknown training option(s) {sorted(bad)}; the options "
+                            f"are: {', '.join(asdict(p.train))}")
     return replace(p, model=replace(p.model), train=replace(p.train, **train_overrides))
 
 

@@ -20,6 +20,7 @@ from typing import Iterable
 import numpy as np
 import torch
 
+from .errors import PGAELiteError
 from .language import VOCABULARY
 from .patterns import MAX_STEPS, Pattern
 from .utils import array_digest, atomic_write
@@ -28,7 +29,7 @@ JOINT_DIM = 5
 VISION_DIM = 30
 
 
-class DataFormatError(ValueError):
+class DataFormatError(PGAELiteError, ValueError):
     """The authors' data folder (:mod:`pgae_lite.original`) or a dataset file is missing or malformed."""
 
 

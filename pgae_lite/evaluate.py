@@ -19,9 +19,11 @@ import numpy as np
 import torch
 
 from .data import Normaliser, PGAEDataset
+from .errors import ArgumentError
 from .language import SIGNALS, TEST_SIGNALS, VOCABULARY, decode, is_correct, normalise_signal
 from .pgae import PGAE
 from .signals import LANG_OUT, make_batch, signal_ids
+from .validate_api import instance_of, positive_number, whole_number
 
 #: The paper's Table 1: (accuracy %, nRMSE %) per row and signal.
 PAPER_TABLE: dict[str, dict[str, tuple[float, float]]] = {
@@ -49,6 +51,14 @@ class Predictions:
     gate: np.ndarray       # (N, hidden) GMU gate values
 
 
+def check_model_inputs(model: PGAE, data: PGAEDataset, normaliser: Normaliser) -> None:
+    """A one-sentence ArgumentTypeError unless the three are what their names say."""
+    instance_of("model", model, torch.nn.Module, "a model (a PGAE, a torch.nn.Module)")
+    instance_of("data", data, PGAEDataset, "a PGAEDataset")
+    instance_of("normaliser", normaliser, Normaliser,
+                "a Normaliser, e.g. Normaliser.fit(data.split('train'))")
+
+
 @torch.no_grad()
 def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
             opposite: bool = False, batch_size: int = 256,
@@ -61,7 +71,16 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
     :func:`pgae_lite.instructions.instruction_features`: with ``"execute"`` the paper's
     execute (open loop: the recorded vision at every step) of those instructions.
     """
+    check_model_inputs(model, data, normaliser)
     signal = normalise_signal(signal)
+    instance_of("opposite", opposite, (bool, np.bool_), "True or False")
+    whole_number("batch_size", batch_size, 1)
+    instance_of("language", language, torch.Tensor, f"a tensor ({len(data)}, D)",
+                optional=True)
+    if language is not None and (language.dim() != 2 or len(language) != len(data)):
+        raise ArgumentError(f"language must be a tensor of shape ({len(data)}, D), "
+                            f"one row per sample of data; got shape "
+                            f"{tuple(language.shape)}")
     model.eval()
     device = next(model.parameters()).device
     tensors = tensors or normaliser.tensors(data, device)
@@ -94,6 +113,8 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
 
 def nrmse(pred: Predictions, joint_range: float) -> tuple[float, float]:
     """(nRMSE over valid predicted steps, nRMSE the authors' padded way), both in %."""
+    instance_of("pred", pred, Predictions, "the Predictions of predict()")
+    joint_range = positive_number("joint_range", joint_range)
     err = (pred.joints[:, 1:] - pred.target[:, 1:]) ** 2             # step 0 is given, not predicted
     valid = ~np.isnan(err)
     sq = np.nansum(err)
@@ -109,7 +130,11 @@ def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str 
 
     ``joint_range`` defaults to the observed range over the whole dataset.
     """
-    joint_range = joint_range or data.joint_range()
+    check_model_inputs(model, data, normaliser)
+    if joint_range is None:
+        joint_range = data.joint_range()
+    else:
+        joint_range = positive_number("joint_range", joint_range)
     subset = data.split(split)
     tensors = normaliser.tensors(subset, next(model.parameters()).device)
     results, preds = {}, {}
@@ -132,6 +157,21 @@ def format_table(results: dict[str, dict[str, dict[str, float]]], paper_rows: di
     over seeds, printed as ``mean ± std``.
     """
     paper_rows = paper_rows or {}
+    unknown = sorted(set(paper_rows.values()) - set(PAPER_TABLE))
+    if unknown:
+        raise ArgumentError(f"paper_rows names {unknown[0]!r}, not a row of the "
+                            f"paper's Table 1; the rows are: {', '.join(PAPER_TABLE)}")
+    lacking = sorted(set(results) - set(std)) if std is not None else []
+    if lacking:
+        raise ArgumentError(f"std has no cells for the row {lacking[0]!r}; give it "
+                            "every row of results")
+    for name, cells in [*results.items(), *(std or {}).items()]:
+        missing = [s for s in TEST_SIGNALS if s not in cells]
+        if missing:
+            raise ArgumentError(f"the cells of {name!r} lack the signal(s) "
+                                f"{', '.join(missing)}; each row needs "
+                                f"{', '.join(TEST_SIGNALS)} (as evaluate() returns "
+                                "them)")
 
     def cell(name: str, signal: str, key: str, fmt: str) -> str:
         value = format(results[name][signal][key], fmt)

@@ -25,7 +25,7 @@ from .language import WORD_INDEX, LanguageError, parse_description, signal_index
 from .paraphrases import Paraphrase, load_paraphrases
 from .patterns import Pattern
 from .pgae import PGAE
-from .pretrained import input_text
+from .pretrained import check_texts, input_text
 from .signals import EOS, SIGNAL_TOKEN
 from .simdata import DatasetConfig
 
@@ -39,7 +39,7 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
     its vocabulary: every text must be a description (action colour speed),
     else a :class:`~pgae_lite.language.LanguageError` names the unknown words.
     """
-    encoder = model.language_encoder
+    texts, encoder = check_texts("instruction_features", texts), model.language_encoder
     if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
         return encoder.encode_texts([input_text("execute", t) for t in texts])
     for t in texts:

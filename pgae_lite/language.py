@@ -17,6 +17,8 @@ import re
 
 import torch
 
+from .errors import PGAELiteError
+
 BOS_EOS = "<BOS/EOS>"
 
 #: The 23 output words, in the index order of the authors' ``vocabulary.txt``.
@@ -59,7 +61,7 @@ WORD_WEIGHTS: dict[str, float] = {
 }
 
 
-class LanguageError(ValueError):
+class LanguageError(PGAELiteError, ValueError):
     """Bad user text or signal; the message says what was wrong and what is allowed."""
 
 
@@ -88,6 +90,9 @@ def tokenize(text: str) -> list[str]:
     written with a space (``move up``, ``greenish blue``). Unknown words raise
     :class:`LanguageError` naming every one of them and listing the vocabulary.
     """
+    if not isinstance(text, str):
+        raise LanguageError(f"the text must be a string, e.g. 'push red slowly'; got "
+                            f"{type(text).__name__} {text!r:.80}")
     words = re.sub(r"[.,;:!?]", " ", str(text).lower().replace(BOS_EOS.lower(), " ")).split()
     tokens: list[str] = []
     unknown: list[str] = []
@@ -140,7 +145,20 @@ def equivalent_descriptions(action: str, colour: str, speed: str) -> list[tuple[
 
 
 def encode(words: tuple[str, ...] | list[str]) -> torch.Tensor:
-    """Word list -> index tensor with ``<BOS/EOS>`` at both ends, shape (len + 2,)."""
+    """Word list -> index tensor with ``<BOS/EOS>`` at both ends, shape (len + 2,).
+
+    The words are vocabulary words as written (``move-up``, not ``move up``); a string,
+    or any other word, raises :class:`LanguageError` (:func:`tokenize` splits text).
+    """
+    if not isinstance(words, (list, tuple)):
+        raise LanguageError(f"encode takes a list of vocabulary words, e.g. "
+                            f"['push', 'red', 'slowly']; got {type(words).__name__} "
+                            f"{words!r:.80} (tokenize(text) splits text into words)")
+    for position, word in enumerate(words):
+        if not isinstance(word, str) or word not in WORD_INDEX or word == BOS_EOS:
+            vocab = ", ".join(w for w in VOCABULARY if w != BOS_EOS)
+            raise LanguageError(f"encode got {word!r:.80} at position {position}, not "
+                                f"a word of the vocabulary: {vocab}")
     return torch.tensor([0] + [WORD_INDEX[w] for w in words] + [0])
 
 
@@ -153,16 +171,42 @@ def decode(indices: torch.Tensor | list[int]) -> str:
     """Generated word indices (or one-hot / probability rows) -> text.
 
     Reading stops at the first ``<BOS/EOS>``, so an output of ``<EOS>`` alone gives ``""``.
+    Anything else (an index outside 0-22, a fraction, text, rows of another width)
+    raises :class:`LanguageError` naming it.
     """
-    t = torch.as_tensor(indices)
-    if t.dim() == 2:  # (steps, 23) one-hot or probabilities
-        t = t.argmax(-1)
+    t = _word_indices(indices)
     words = []
     for i in t.tolist():
         if i == 0:
             break
         words.append(VOCABULARY[i])
     return " ".join(words)
+
+
+def _word_indices(indices) -> torch.Tensor:
+    """:func:`decode`'s input checked: 1-D integer indices 0-22, or a LanguageError."""
+    n = len(VOCABULARY)
+    wanted = (f"decode takes word indices (whole numbers 0-{n - 1}) or rows of "
+              f"{n} scores (steps, {n})")
+    if isinstance(indices, (str, bytes)):
+        raise LanguageError(f"{wanted}; got the text {indices!r:.80} "
+                            "(parse_description reads text)")
+    if isinstance(indices, (list, tuple)) and any(isinstance(i, bool) for i in indices):
+        raise LanguageError(f"{wanted}; got {indices!r:.80}, with True or False in it")
+    try:
+        t = torch.as_tensor(indices)
+    except (TypeError, ValueError, RuntimeError, OverflowError):
+        raise LanguageError(f"{wanted}; got {indices!r:.80}") from None
+    if t.dim() == 2 and t.shape[1] == n and t.dtype != torch.bool:
+        return t.argmax(-1)       # (steps, 23) one-hot or probabilities
+    if t.dim() != 1 or t.dtype == torch.bool or t.is_complex():
+        raise LanguageError(f"{wanted}; got {t.dim()}-D {t.dtype} of shape "
+                            f"{tuple(t.shape)}")
+    bad = ((t < 0) | (t >= n) | (t != t.round())).nonzero().flatten()
+    if len(bad):
+        i = int(bad[0])
+        raise LanguageError(f"{wanted}; got {t[i].item()} at position {i}")
+    return t.long()
 
 
 def is_correct(generated: str, alternatives: list[tuple[str, ...]] | None) -> bool:

@@ -40,6 +40,7 @@ from .cae import ChannelSeparatedCAE
 from .closedloop import closed_loop, open_loop, pattern_for
 from .config import PROFILES
 from .data import Normaliser, PGAEDataset, description_text
+from .errors import PGAELiteError
 from .language import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
     parse_description, tokenize
 from .patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
@@ -48,6 +49,9 @@ from .pretrained import input_text
 from .signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from .sim.record import Execution
 from .simdata import DatasetConfig
+from .validate_api import instance_of, positive_number, whole_number
+from .validate_playground import (LAST_PATTERN, action_number, arrangement_number,
+                                  check_objects, check_playground)
 from .viz import animate_frames, plot_joints
 
 #: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
@@ -63,29 +67,34 @@ TARGETS: dict[str, str] = {"describe": "the final recorded pose, held", "execute
 
 def arrangement_label(arrangement: int) -> str:
     """E.g. ``"red left, blue right"`` for arrangement 0."""
-    left, right = ARRANGEMENTS[arrangement]
+    left, right = ARRANGEMENTS[arrangement_number(arrangement)]
     return f"{left} left, {right} right"
 
 
 def action_label(action: int) -> str:
     """E.g. ``"push the left cube, slowly"`` for action 0."""
-    act, side, speed = ACTIONS[action]
+    act, side, speed = ACTIONS[action_number(action)]
     return f"{act} the {'left' if side == 'L' else 'right'} cube, {speed}"
 
 
 def pattern_number(arrangement: int, action: int) -> int:
     """The pattern (0-143) of action ``action`` (0-11) in arrangement ``arrangement`` (0-11)."""
+    arrangement, action = arrangement_number(arrangement), action_number(action)
     return patterns.pattern_number(action // 6, arrangement, action % 6)
 
 
 def simulator_config(data: PGAEDataset) -> DatasetConfig:
     """The simulated dataset's config (found by the key in ``data.source``), else the book profile's."""
+    instance_of("data", data, PGAEDataset, "a PGAEDataset")
     key = str(data.source).rpartition(":")[2]
     return next((p.data for p in PROFILES.values() if p.data.key() == key), PROFILES["book"].data)
 
 
 def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[int, int]:
     """(row in ``data``, simulator variation) of the ``variation``-th recording of ``pattern``."""
+    instance_of("data", data, PGAEDataset, "a PGAEDataset")
+    pattern = whole_number("pattern", pattern, 0, LAST_PATTERN)
+    variation = whole_number("variation", variation, 0)
     rows = np.flatnonzero(data.pattern == pattern)
     if variation >= len(rows):
         p = Pattern.from_number(pattern)
@@ -147,6 +156,8 @@ class PlayResult:
 
     def animation(self, every: int = 4, size: float = 3.0, dpi: int = 60):
         """The robot executing the joints, from NICO's eye, and its joints (a matplotlib animation), or None."""
+        whole_number("every", every, 1), whole_number("dpi", dpi, 1)
+        positive_number("size", size)
         if self.rollout is None:
             return None
         title = f"{textwrap.shorten(self.told, 36)}: {'done' if self.rollout.passed else 'failed'}"
@@ -200,9 +211,12 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     ``"open"`` (:func:`~pgae_lite.closedloop.open_loop`), ``"closed"`` (execute
     only: :func:`~pgae_lite.closedloop.closed_loop`, which needs ``cae``) or
     None (no simulation). ``config``: the simulated dataset's (default: found
-    from ``data``). Raises LanguageError or ValueError with a readable message
-    for a bad signal, text or choice.
+    from ``data``). Raises LanguageError or ValueError (a TypeError for a wrong type),
+    with a readable message, for a bad signal, text, choice or object.
     """
+    check_objects(model, cae, normaliser, data, config)
+    pattern_number(arrangement, action)                    # checks both
+    instance_of("text", text, str, "a description (a string)", optional=True)
     signal, text = normalise_signal(signal), (text or "").strip()
     if loop not in ("open", "closed", None):
         raise ValueError(f"unknown loop {loop!r}; the options are: 'open', 'closed', None")
@@ -263,6 +277,8 @@ class Playground:
                  signal: str = "execute", arrangement: int | None = None, action: int = 0):
         import ipywidgets as w
 
+        check_playground(models, cae, data, config, every, signal, arrangement, action,
+                         PLAY_SIGNALS)
         self.models, self.cae, self.data, self.config, self.every = dict(models), cae, data, config, every
         self.result: PlayResult | None = None
         self.message = ""
@@ -299,7 +315,7 @@ class Playground:
                                self.action.value, self.text.value, variation=self.variation.value,
                                loop=self.loop.value, config=self.config)
             shown = self.result.displays(self.every)
-        except ValueError as e:                            # LanguageError too: the reader's choice, not a bug
+        except (ValueError, PGAELiteError) as e:   # the reader's choice, not a bug
             self.message = str(e)
             shown = [HTML(f'<p style="color:#a40000"><b>Cannot run this:</b> {html.escape(self.message)}</p>')]
         finally:

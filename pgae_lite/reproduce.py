@@ -16,6 +16,7 @@ paper). With several seeds every cell is reported as mean ± standard deviation.
 Output folder layout (``out``)::
 
     results.json                 every cell of every row and seed, mean and std, times
+                                 (strict JSON: a NaN or an infinity is written as null)
     predictions.npz              the first row's predictions for the first seed
     TRAINING-seedS/checkpoint.pt one folder per training and seed (resumable)
     TRAINING-seedS/predictions-ROW.npz
@@ -23,6 +24,8 @@ Output folder layout (``out``)::
 from __future__ import annotations
 
 import json
+import math
+import os
 import shutil
 import statistics
 import time
@@ -33,31 +36,101 @@ import numpy as np
 
 from .config import ROWS, TRAININGS, Profile, get_profile, training_profile  # TRAININGS: the README names it here
 from .data import PGAEDataset
+from .errors import ArgumentError
 from .evaluate import PAPER_TABLE, Predictions, evaluate, format_table
 from .language import TEST_SIGNALS
+from .pretrained import model_source
 from .train import train
-from .utils import atomic_write
+from .utils import atomic_write, atomic_write_text
+from .validate_api import MAX_SEED, instance_of, torch_device, whole_number
 
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
 CELLS = ("accuracy", "nrmse", "nrmse_padded")
+MAX_SEEDS = 100                                     # models per row: a sane count
+#: The command line's name of each argument :func:`check_arguments` checks.
+FLAGS = {"original_data": "--original-data", "rows": "--rows", "seed": "--seed",
+         "seeds": "--seeds", "epochs": "--epochs", "device": "--device",
+         "pretrained_model": "--pretrained-model", "out_dir": "--out"}
 
 
 def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
     """``"all"``, a comma-separated string or a list of row names -> checked list (case-insensitive)."""
     if rows is None:
         return ["PGAE"]
+    instance_of("rows", rows, (str, list, tuple), "'all', a list or names and commas")
     if isinstance(rows, str):
         rows = list(ROWS) if rows.strip().lower() == "all" else rows.split(",")
+    if not rows:
+        raise ArgumentError(f"rows is empty; the rows are: {', '.join(ROWS)} or 'all'")
     by_lower = {r.lower(): r for r in ROWS}
     out = []
     for r in rows:
-        name = by_lower.get(r.strip().lower())
+        name = by_lower.get(r.strip().lower()) if isinstance(r, str) else None
         if name is None:
-            raise ValueError(f"unknown row {r.strip()!r}; the rows are: {', '.join(ROWS)} (or 'all')")
+            shown = r.strip() if isinstance(r, str) else r
+            raise ArgumentError(f"unknown row {shown!r}; the rows are: "
+                                f"{', '.join(ROWS)} (or 'all')")
         if name not in out:
             out.append(name)
     return out
+
+
+def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained_model,
+                    out_dir, cli: bool = False) -> list[str]:
+    """:func:`reproduce`'s arguments checked before any data is read; returns the rows.
+
+    A bad one raises a one-sentence :class:`~pgae_lite.errors.PGAELiteError` that
+    names it as the command line does (:data:`FLAGS`) if ``cli``.
+    """
+    name = FLAGS if cli else {key: key for key in FLAGS}
+    rows = parse_rows(rows)
+    whole_number(name["seed"], seed, 0, MAX_SEED)
+    whole_number(name["seeds"], seeds, 1, MAX_SEEDS)
+    if seed + seeds - 1 > MAX_SEED:
+        raise ArgumentError(f"{name['seed']} {seed} with {name['seeds']} {seeds} "
+                            f"reaches seed {seed + seeds - 1}; seeds go up to "
+                            f"2**32 - 1 = {MAX_SEED}")
+    if epochs is not None:
+        whole_number(name["epochs"], epochs, 1)
+    torch_device(name["device"], device)
+    defaults = {"original_data": "our simulated data",
+                "out_dir": "runs/DATA-PROFILE-seedSEED"}
+    for key, value in (("original_data", original_data), ("out_dir", out_dir)):
+        instance_of(name[key], value, (str, os.PathLike), "a folder (str or Path)",
+                    optional=True)
+        if value is not None and not str(value).strip():
+            raise ArgumentError(f"{name[key]} is empty (an unset variable?); give a "
+                                f"folder, or leave {name[key]} out for the default: "
+                                f"{defaults[key]}")
+    if "PGAE-BERT" in rows:
+        model_source(pretrained_model)     # a missing model: refused before any data
+    elif pretrained_model is not None:
+        raise ArgumentError(f"{name['pretrained_model']} {pretrained_model!r} is "
+                            f"PGAE-BERT's language model, but the rows "
+                            f"({', '.join(rows)}) do not include PGAE-BERT; add it to "
+                            f"{name['rows']} or leave {name['pretrained_model']} out")
+    return rows
+
+
+def finite_or_null(obj) -> tuple[object, int]:
+    """``obj`` with each NaN or infinity replaced by None (JSON's null); their count."""
+    if isinstance(obj, float):
+        return (obj, 0) if math.isfinite(obj) else (None, 1)
+    if isinstance(obj, (dict, list, tuple)):
+        keys = list(obj) if isinstance(obj, dict) else range(len(obj))
+        pairs = [finite_or_null(obj[k]) for k in keys]
+        values = [v for v, _ in pairs]
+        clean = dict(zip(keys, values)) if isinstance(obj, dict) else values
+        return clean, sum(n for _, n in pairs)
+    return obj, 0
+
+
+def write_results(path: Path, report: dict) -> int:
+    """``report`` as strict JSON (NaN, infinities as null), atomically; their count."""
+    clean, nonfinite = finite_or_null(report)
+    atomic_write_text(path, json.dumps(clean, indent=2, allow_nan=False))
+    return nonfinite
 
 
 def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
@@ -126,26 +199,27 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
     our simulated data (simulator -> CAE -> PGAE, each step cached). ``rows``: see
     :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
-    per row are trained, with seeds ``seed, seed + 1, ...``.
+    per row are trained, with seeds ``seed, seed + 1, ...``. Every argument is checked
+    before any data is read (:func:`check_arguments`).
     """
     from .original import load_original
 
-    rows = parse_rows(rows)
-    if seeds < 1:
-        raise ValueError(f"seeds must be at least 1, got {seeds}")
-    prof = get_profile(profile, **({"epochs": epochs} if epochs else {}))
-    if original_data:
+    rows = check_arguments(original_data, rows, seed, seeds, epochs, device,
+                           pretrained_model, out_dir)
+    prof = get_profile(profile, **({} if epochs is None else {"epochs": epochs}))
+    if original_data is not None:
         dataset, source = load_original(original_data), "original"
     else:
         from .pipeline import simulated_dataset
         dataset, source = simulated_dataset(prof.name, device, progress), "simulated"
-    out = Path(out_dir or f"runs/{source}-{prof.name}-seed{seed}")
+    default_out = f"runs/{source}-{prof.name}-seed{seed}"
+    out = Path(out_dir if out_dir is not None else default_out)
     t0 = time.perf_counter()
     report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,
                         pretrained_model)
-    report |= {"data": str(original_data) if original_data else dataset.source,
+    report |= {"data": dataset.source if original_data is None else str(original_data),
                "wall_seconds": time.perf_counter() - t0}
-    (out / "results.json").write_text(json.dumps(report, indent=2))
+    nonfinite = write_results(out / "results.json", report)
     print(format_table({f"{r} (ours)": report["rows"][r]["mean"] for r in rows},
                        {f"{r} (ours)": r for r in rows},
                        std={f"{r} (ours)": report["rows"][r]["std"] for r in rows} if seeds > 1 else None))
@@ -153,7 +227,11 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
                       for t, v in report["trainings"].items())
     print(f"\nprofile {prof.name}, seeds {report['seeds']}, mean training time: {times}; "
           f"wrote {out / 'results.json'} and {out / 'predictions.npz'}")
+    if nonfinite:
+        print(f"note: {nonfinite} value(s) were not finite (NaN or infinite); "
+              "results.json holds null there")
     return report
 
 
-__all__ = ["reproduce", "run_table1", "parse_rows", "save_predictions", "summarise"]
+__all__ = ["FLAGS", "MAX_SEEDS", "check_arguments", "finite_or_null", "parse_rows",
+           "reproduce", "run_table1", "save_predictions", "summarise", "write_results"]

@@ -40,6 +40,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from .data import PGAEDataset, from_recordings
+from .errors import PGAELiteError
 from .patterns import Pattern
 from .sim.record import Episode, SimConfig, record_episode
 from .utils import (array_digest, atomic_write, atomic_write_text, cache_dir,
@@ -72,7 +73,7 @@ class DatasetConfig:
         return config_digest({"version": GENERATOR_VERSION, **asdict(self)})
 
 
-class CorruptEpisodeError(RuntimeError):
+class CorruptEpisodeError(PGAELiteError, RuntimeError):
     """A cached episode file is damaged or does not match what was recorded."""
 
 

@@ -23,6 +23,7 @@ from tqdm.auto import tqdm
 
 from .config import ModelConfig, Profile, get_profile
 from .data import JOINT_DIM, Normaliser, PGAEDataset
+from .errors import PGAELiteError
 from .language import SIGNALS, word_weights
 from .pgae import PGAE
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
@@ -84,7 +85,7 @@ def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | N
     return action_input + scale * noise
 
 
-class DataMismatchError(ValueError):
+class DataMismatchError(PGAELiteError, ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
 

@@ -35,10 +35,12 @@ from typing import IO, Iterator
 import numpy as np
 import torch
 
+from .errors import PGAELiteError
+
 CACHE_ENV = "PGAE_LITE_CACHE"
 
 
-class CheckpointMismatchError(ValueError):
+class CheckpointMismatchError(PGAELiteError, ValueError):
     """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
 
 

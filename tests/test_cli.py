@@ -167,7 +167,7 @@ def test_unknown_row_and_bad_seed_count_are_clear_errors(capsys):
     assert "'GPT'" in err and "PGAE-BERT" in err and "PGAE-opposite" in err
     with pytest.raises(SystemExit):
         main(["reproduce", "--seeds", "0"])
-    assert "at least 1" in capsys.readouterr().err
+    assert "--seeds must be a whole number from 1 to 100" in capsys.readouterr().err
 
 
 def test_cli_profile_names_match_the_package():
