@@ -89,7 +89,7 @@ class DataMismatchError(PGAELiteError, ValueError):
     """A checkpoint is used with data (visual features) other than those it was trained on."""
 
 
-class NonFiniteLossError(FloatingPointError):
+class NonFiniteLossError(PGAELiteError, FloatingPointError):
     """The training loss became NaN or infinite: the run stops, nothing is saved."""
 
 

@@ -44,15 +44,15 @@ class CheckpointMismatchError(PGAELiteError, ValueError):
     """An output folder holds a checkpoint of a different recipe; nothing is overwritten."""
 
 
-class CorruptCheckpointError(ValueError):
+class CorruptCheckpointError(PGAELiteError, ValueError):
     """A checkpoint is empty, truncated, foreign, or holds more than tensors, data."""
 
 
-class OutputError(OSError):
+class OutputError(PGAELiteError, OSError):
     """A file or folder cannot be written (full disk, read-only, a file in the way)."""
 
 
-class FolderBusyError(RuntimeError):
+class FolderBusyError(PGAELiteError, RuntimeError):
     """Another live process is training into the same output folder."""
 
 
