@@ -145,10 +145,10 @@ def load_pgae(path: str | Path, world: World, device: str | None = None
     model = PGAE(ModelConfig(**ckpt["profile"]["model"]), world.lexicon)
     try:
         model.load_state_dict(ckpt["model"])
-    except RuntimeError as e:
-        raise ValueError(f"{path} was not trained for this world's "
-                         f"{world.lexicon.size} words "
-                         f"({e.args[0].splitlines()[0]})") from None
+    except RuntimeError as e:                     # the first mismatch, e.g. the words
+        first = next((line.strip() for line in str(e).splitlines()[1:]), str(e))
+        raise ValueError(f"{path} does not fit PGAE for this world's "
+                         f"{world.lexicon.size} words: {first}") from None
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
