@@ -49,7 +49,7 @@ def test_default_world_is_the_papers():
 def test_default_keys_and_weights_unchanged():
     for name in ("smoke", "book"):
         data = get_profile(name).data
-        old = {k: v for k, v in asdict(data).items() if k != "world"}   # key before worlds
+        old = {k: v for k, v in asdict(data).items() if k != "world"}   # as before
         assert data.key() == config_digest({"version": GENERATOR_VERSION, **old})
         assert "world" not in data.to_dict()
     assert DEFAULT_LEXICON.word_weights() == L.WORD_WEIGHTS     # the authors', by rule
@@ -99,7 +99,7 @@ def test_new_patterns_numbering_and_split():
                                        ("orange", "violet"), ("violet", "orange"))
     for n in range(192):
         assert WORLD.pattern_number(*WORLD.pattern_parts(n)) == n
-    p = WORLD.pattern(144 + 12 * 1 + 6 * 1 + 3)            # arrangement 13, fast, push R
+    p = WORLD.pattern(144 + 12 * 1 + 6 * 1 + 3)        # arrangement 13, fast, push R
     assert (p.left, p.right, p.code, p.colour) == ("blue", "orange", "PUSH-R-FAST",
                                                    "orange")
     with pytest.raises(ValueError, match="0-143"):
@@ -111,7 +111,7 @@ def test_new_patterns_numbering_and_split():
         q = WORLD.pattern(n)
         if q.colour == "orange":
             meanings.setdefault((q.action, q.speed), []).append(q.is_test)
-    assert len(meanings) == 6                          # every orange meaning is held out
+    assert len(meanings) == 6                      # every orange meaning is held out
     assert all(sum(t) == 1 and len(t) - sum(t) == 3 for t in meanings.values())   # once
     codes = {Pattern.from_number(n).code for n in range(144)}   # the 12 action codes
     assert {WORLD.pattern(n).code for n in new_test} == codes        # each one tested
@@ -143,7 +143,7 @@ def test_simulator_builds_and_records_the_new_cube():
         scene.close()
     orange = (np.abs(frame - [250, 128, 13]).sum(-1) < 90).sum()
     assert orange > 50, "the orange cube is in NICO's view"
-    ep = record_episode(150, 0, world=WORLD)     # (orange, blue): push the left cube fast
+    ep = record_episode(150, 0, world=WORLD)     # (orange, blue): push left cube fast
     assert ep.valid and ep.joints.shape == (50, 5) and ep.displacement[0, 0] > 0.04
 
 
