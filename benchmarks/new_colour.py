@@ -11,7 +11,8 @@ the wrong cube's or the wrong action's mean trajectory costs).
     python benchmarks/new_colour.py --threads 1                 # the book profile
     python benchmarks/new_colour.py --threads 1 --epochs 100    # a reduced budget
 
-Every step is cached (PGAE_LITE_CACHE): a second run only evaluates.
+Every step is cached (PGAE_LITE_CACHE): a second run only evaluates; the result
+says which steps came from the cache (their seconds are then loading times).
 """
 from __future__ import annotations
 
@@ -69,6 +70,11 @@ def main() -> None:
 
     world = with_colour(args.colour, args.synonym, args.rgba)
     overrides = {"epochs": args.epochs} if args.epochs else {}
+    cae = extended.cae_path(world, args.profile)
+    folder = extended.pgae_folder(world, args.profile, args.seeds[0], **overrides)
+    cached = {"cae": cae.exists(),                      # True: the step only loads
+              "features": (cae.parent.parent / "features" / f"{cae.stem}.npz").exists(),
+              "pgae": (folder / "checkpoint.pt").exists()}
     seconds, t = {}, time.perf_counter()
     report = extended.record(world, args.profile, progress=False)
     seconds["record"] = round(time.perf_counter() - t, 1)
@@ -108,7 +114,8 @@ def main() -> None:
         "episodes_recorded": report.recorded, "first_try": round(report.first_try, 3),
         "epochs": trained.profile.train.epochs,
         "cae_iterations": trained.profile.cae.iterations,
-        "seconds_per_step": seconds, "train_seconds": round(trained.seconds, 1),
+        "seconds_per_step": seconds, "from_cache": cached,
+        "train_seconds": round(trained.seconds, 1),
         "threads": torch.get_num_threads(),
         "check": {"passed": bool(check), "lines": check.lines},
         "cells": cells, "reference_nrmse": reference_errors(data)})
