@@ -167,6 +167,16 @@ def test_pgae_for_the_larger_vocabulary_trains_and_loads(tmp_path):
 
 
 # ------------------------------------------------------------------ the check
+def test_check_colour_knows_the_worlds_colours():
+    from pgae_lite.exercises import check_colour
+
+    assert not check_colour("orange", ORANGE, world=WORLD)           # already there
+    assert check_colour("pink", (1.0, 0.4, 0.8, 1.0), world=WORLD)
+    darker = (0.98, 0.45, 0.05, 1.0)                     # near the new orange
+    assert check_colour("tangerine", darker)
+    assert not check_colour("tangerine", darker, world=WORLD)
+
+
 def test_check_new_colour_fails_for_an_untrained_model():
     data = tiny(WORLD, list(range(144, 192)))
     torch.manual_seed(0)

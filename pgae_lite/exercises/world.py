@@ -15,6 +15,7 @@ import numpy as np
 from ..data import Normaliser, PGAEDataset
 from ..evaluate import nrmse, predict
 from ..language import COLOURS, SIGNALS, VOCABULARY
+from ..world import World
 from .result import CheckResult, _call
 
 #: Describe accuracy (%) on the held-out episodes that move the new colour's cube.
@@ -49,16 +50,23 @@ def check_vocabulary(words: Sequence[str], new: Sequence[str] = ()) -> CheckResu
     return result
 
 
-def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2) -> CheckResult:
+def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
+                 world: World | None = None) -> CheckResult:
     """(f) A new cube colour: one lowercase word and an opaque RGBA in [0, 1] that the camera can tell
-    apart from the other cubes and the table (some channel differs by ``min_difference`` or more)."""
+    apart from the other cubes and the table (some channel differs by ``min_difference`` or more).
+
+    ``world``: compare with its colours too (:func:`pgae_lite.world.with_colour`)."""
     from ..sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
+
+    colours = world.lexicon.colours if world is not None else COLOURS
+    rgbas = {**CUBE_RGBA, **(world.rgba if world is not None else {})}
 
     result, values = CheckResult(f"cube colour {name!r}"), [float(v) for v in rgba]
     if not isinstance(name, str) or not name or name != name.lower() or " " in name:
         result.fail(f"{name!r} should be one lowercase word (a hyphen joins two, as in greenish-blue)")
-    elif name in COLOURS:
-        result.fail(f"{name!r} is already one of the six colours of the dataset")
+    elif name in colours:
+        count = "six" if len(colours) == 6 else len(colours)
+        result.fail(f"{name!r} is already one of the {count} colours of the dataset")
     if max(values) > 1 or min(values) < 0:
         result.fail(f"the values must lie in [0, 1]; got {tuple(values)}",
                     "pybullet takes 0..1: divide 0..255 values by 255" if max(values) > 1 else None)
@@ -68,7 +76,8 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2) 
         result.fail(f"alpha is {values[3]}; the cubes are opaque (alpha 1.0)")
     if not result:
         return result
-    others = {**{f"the {c} cube": v for c, v in CUBE_RGBA.items() if c != name}, "the table": TABLE_RGBA}
+    others = {**{f"the {c} cube": v for c, v in rgbas.items() if c != name},
+              "the table": TABLE_RGBA}
     gaps = {o: max(abs(a - b) for a, b in zip(values, v[:3])) for o, v in others.items()}
     closest = min(gaps, key=gaps.get)
     if gaps[closest] < min_difference:
