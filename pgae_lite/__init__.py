@@ -6,8 +6,10 @@ Modules, in the order the book introduces them:
 - ``simdata``     the 864 simulated episodes: generation, cache, split (chapter 02)
 - ``cae``         the channel-separated convolutional autoencoder (chapter 03)
 - ``pipeline``    simulator -> CAE -> features -> trained models, each step cached
+- ``extended``    the same for a world with a new colour: record, retrain CAE and PGAE (A3)
 - ``language``    vocabulary, synonyms, signals, parsing and errors (chapter 04)
 - ``patterns``    the 144 patterns, their numbering and the test split (chapters 01, 02)
+- ``world``       the world's colours, words and patterns as one value; ``with_colour`` (A3)
 - ``data``        the dataset type and its normalisation (with whitening)
 - ``original``    the authors' data loader (appendix A1)
 - ``toydata``     a small synthetic dataset with the paper's structure (tests, quick demos)

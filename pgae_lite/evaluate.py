@@ -20,7 +20,8 @@ import torch
 
 from .data import Normaliser, PGAEDataset
 from .errors import ArgumentError
-from .language import SIGNALS, TEST_SIGNALS, VOCABULARY, decode, is_correct, normalise_signal
+from .language import (DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, VOCABULARY, decode,
+                       is_correct, normalise_signal)
 from .pgae import PGAE
 from .signals import LANG_OUT, make_batch, signal_ids
 from .validate_api import instance_of, positive_number, whole_number
@@ -81,6 +82,7 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
         raise ArgumentError(f"language must be a tensor of shape ({len(data)}, D), "
                             f"one row per sample of data; got shape "
                             f"{tuple(language.shape)}")
+    lexicon = getattr(model, "lexicon", DEFAULT_LEXICON)         # the model's words
     model.eval()
     device = next(model.parameters()).device
     tensors = tensors or normaliser.tensors(data, device)
@@ -94,7 +96,7 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
             out = model(batch)                               # decoders free-running, greedy words
         else:
             out = model(batch, language=language[s:s + len(index)].to(device))
-        texts += [decode(row) for row in out["logits"].argmax(-1).cpu()]
+        texts += [decode(row, lexicon) for row in out["logits"].argmax(-1).cpu()]
         pred = torch.cat([batch.start_joints[:, None], out["joints"]], 1)        # (B, T, 5)
         target = torch.cat([batch.start_joints[:, None], batch.joint_target], 1)
         joints.append(normaliser.joints_to_data(pred).cpu().numpy())
@@ -105,7 +107,8 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
     target_arr = np.where(mask, np.concatenate(targets), np.nan).astype(np.float32)
     expected_text = LANG_OUT[SIGNALS.index(signal)]
     correct = np.array([
-        is_correct(t, [tuple(VOCABULARY[w] for w in alt) for alt in data.descriptions[i]] if expected_text else None)
+        is_correct(t, [tuple(lexicon.vocabulary[w] for w in alt)
+                       for alt in data.descriptions[i]] if expected_text else None)
         for i, t in enumerate(texts)])
     return Predictions(signal, np.asarray(data.ids), texts, joints_arr, target_arr, correct,
                        np.concatenate(gates))

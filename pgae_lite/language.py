@@ -9,11 +9,20 @@ they are appended as 5 extra input dimensions (23 + 5 = 28).
 User text is parsed leniently (case, extra spaces, ``move up`` for
 ``move-up``); anything else raises :class:`LanguageError`, which names the
 offending word and lists what is allowed.
+
+A :class:`Lexicon` holds one vocabulary (words, synonyms, the grammar's slots);
+:data:`DEFAULT_LEXICON` is the paper's, and the module constants below are its
+parts. :meth:`Lexicon.with_colour` appends a colour word and its synonym (not
+from the paper: the guided project "Teach NICO a new colour",
+:mod:`pgae_lite.world`); every function here takes ``lexicon=`` (default: the
+paper's).
 """
 from __future__ import annotations
 
 import itertools
 import re
+from dataclasses import dataclass
+from functools import cached_property
 
 import torch
 
@@ -65,9 +74,90 @@ class LanguageError(PGAELiteError, ValueError):
     """Bad user text or signal; the message says what was wrong and what is allowed."""
 
 
-def word_weights() -> torch.Tensor:
-    """The 23 cross-entropy weights in vocabulary order, shape (23,)."""
-    return torch.tensor([WORD_WEIGHTS[w] for w in VOCABULARY])
+@dataclass(frozen=True)
+class Lexicon:
+    """A vocabulary: the output words in index order and the grammar's canonical words.
+
+    ``synonyms`` holds (canonical word, synonym) pairs. A word's index is its
+    one-hot dimension and its row in every trained weight, so an extended
+    lexicon keeps the paper's 23 words in their order and appends new ones.
+    """
+
+    vocabulary: tuple[str, ...]
+    synonyms: tuple[tuple[str, str], ...]
+    actions: tuple[str, ...]
+    colours: tuple[str, ...]
+    speeds: tuple[str, ...]
+
+    @cached_property
+    def word_index(self) -> dict[str, int]:
+        return {w: i for i, w in enumerate(self.vocabulary)}
+
+    @cached_property
+    def synonym(self) -> dict[str, str]:
+        """Canonical word -> its synonym."""
+        return dict(self.synonyms)
+
+    @cached_property
+    def canonical(self) -> dict[str, str]:
+        """Any word -> its canonical word."""
+        return {**{w: w for w, _ in self.synonyms}, **{s: w for w, s in self.synonyms}}
+
+    @property
+    def slots(self) -> tuple[tuple[str, ...], ...]:
+        return (self.actions, self.colours, self.speeds)
+
+    @property
+    def size(self) -> int:
+        """Number of output words (23 for the paper's)."""
+        return len(self.vocabulary)
+
+    @property
+    def input_dim(self) -> int:
+        """Input dimensions of the language encoder: the words + 5 signal tokens."""
+        return self.size + len(SIGNALS)
+
+    def word_weights(self) -> dict[str, float]:
+        """Inverse-frequency weights (the authors' rule), mean 1, rounded to 4 digits.
+
+        A word of a slot with n canonical words occurs in 1 of 2n descriptions,
+        ``<BOS/EOS>`` in every one: weight ∝ 1 / frequency. For the paper's
+        lexicon this gives the authors' table, :data:`WORD_WEIGHTS` (a test checks it).
+        """
+        inverse = {BOS_EOS: 1.0}
+        for slot in self.slots:
+            for c in slot:
+                inverse.update({c: 2.0 * len(slot), self.synonym[c]: 2.0 * len(slot)})
+        mean = sum(inverse[w] for w in self.vocabulary) / self.size
+        return {w: round(inverse[w] / mean, 4) for w in self.vocabulary}
+
+    def with_colour(self, name: str, synonym: str) -> "Lexicon":
+        """This lexicon with a colour word and its synonym appended to the words."""
+        for word, what in ((name, "colour"), (synonym, "synonym")):
+            if not isinstance(word, str) or not re.fullmatch(r"[a-z]+(-[a-z]+)*", word):
+                raise LanguageError(f"the {what} {word!r} must be one lowercase word "
+                                    "(a hyphen joins two, as in greenish-blue)")
+            if word in self.word_index or word in SIGNALS:
+                raise LanguageError(f"the {what} {word!r} is already a word of the "
+                                    f"vocabulary; the words are: "
+                                    f"{', '.join(self.vocabulary[1:])}")
+        if name == synonym:
+            raise LanguageError(f"the synonym of {name!r} must be another word")
+        return Lexicon(self.vocabulary + (name, synonym),
+                       self.synonyms + ((name, synonym),),
+                       self.actions, self.colours + (name,), self.speeds)
+
+
+#: The paper's lexicon: the 23 words of the authors' ``vocabulary.txt``.
+DEFAULT_LEXICON = Lexicon(VOCABULARY, tuple(SYNONYMS.items()), ACTIONS, COLOURS, SPEEDS)
+
+
+def word_weights(lexicon: Lexicon | None = None) -> torch.Tensor:
+    """The cross-entropy weights in vocabulary order, shape (23,) (or the lexicon's)."""
+    if lexicon is None or lexicon == DEFAULT_LEXICON:
+        return torch.tensor([WORD_WEIGHTS[w] for w in VOCABULARY])
+    weights = lexicon.word_weights()
+    return torch.tensor([weights[w] for w in lexicon.vocabulary])
 
 
 def normalise_signal(signal: str) -> str:
@@ -83,7 +173,7 @@ def signal_index(signal: str) -> int:
     return SIGNALS.index(normalise_signal(signal))
 
 
-def tokenize(text: str) -> list[str]:
+def tokenize(text: str, lexicon: Lexicon | None = None) -> list[str]:
     """Split user text into vocabulary words, leniently.
 
     Case, punctuation and extra spaces are ignored and two-word synonyms may be
@@ -93,73 +183,81 @@ def tokenize(text: str) -> list[str]:
     if not isinstance(text, str):
         raise LanguageError(f"the text must be a string, e.g. 'push red slowly'; got "
                             f"{type(text).__name__} {text!r:.80}")
+    lex = lexicon or DEFAULT_LEXICON
     words = re.sub(r"[.,;:!?]", " ", str(text).lower().replace(BOS_EOS.lower(), " ")).split()
     tokens: list[str] = []
     unknown: list[str] = []
     i = 0
     while i < len(words):
         pair = "-".join(words[i:i + 2])
-        if i + 1 < len(words) and pair in WORD_INDEX:
+        if i + 1 < len(words) and pair in lex.word_index:
             tokens.append(pair)
             i += 2
         else:
-            (tokens if words[i] in WORD_INDEX else unknown).append(words[i])
+            (tokens if words[i] in lex.word_index else unknown).append(words[i])
             i += 1
     if unknown:
-        vocab = ", ".join(sorted(w for w in VOCABULARY if w != BOS_EOS))
+        vocab = ", ".join(sorted(w for w in lex.vocabulary if w != BOS_EOS))
         listed = ", ".join(repr(w) for w in dict.fromkeys(unknown))
         raise LanguageError(f"unknown word{'s' if len(set(unknown)) > 1 else ''} {listed} in {text!r}; "
                             f"the vocabulary is: {vocab}")
     return tokens
 
 
-def parse_description(text: str) -> tuple[str, str, str]:
+def parse_description(text: str, lexicon: Lexicon | None = None
+                      ) -> tuple[str, str, str]:
     """Parse ``action colour speed`` into canonical words, e.g. ``('push', 'red', 'fast')``.
 
     Raises :class:`LanguageError` for unknown words, a wrong length or a word in
     the wrong position (the message says which word each position allows).
     """
-    tokens = tokenize(text)
+    lex = lexicon or DEFAULT_LEXICON
+    tokens = tokenize(text, lex)
     if len(tokens) != 3:
         raise LanguageError(
             f"a description has 3 words (action colour speed), got {len(tokens)} in {text!r}")
     canon = []
-    for token, slot, name in zip(tokens, SLOTS, SLOT_NAMES):
-        word = CANONICAL.get(token)
+    for token, slot, name in zip(tokens, lex.slots, SLOT_NAMES):
+        word = lex.canonical.get(token)
         if word not in slot:
-            allowed = ", ".join(w2 for w in slot for w2 in (w, SYNONYMS[w]))
+            allowed = ", ".join(w2 for w in slot for w2 in (w, lex.synonym[w]))
             raise LanguageError(f"{token!r} cannot be the {name} word in {text!r}; allowed: {allowed}")
         canon.append(word)
     return tuple(canon)  # type: ignore[return-value]
 
 
-def equivalent_descriptions(action: str, colour: str, speed: str) -> list[tuple[str, str, str]]:
+def equivalent_descriptions(action: str, colour: str, speed: str,
+                            lexicon: Lexicon | None = None
+                            ) -> list[tuple[str, str, str]]:
     """The 8 equivalent descriptions of one meaning (each word or its synonym).
 
     Order follows the authors' data: canonical first, the action word's
     synonym varying fastest, then the colour's, then the speed's.
     """
-    words = parse_description(f"{action} {colour} {speed}")
-    choices = [(w, SYNONYMS[w]) for w in reversed(words)]   # speed, colour, action
+    lex = lexicon or DEFAULT_LEXICON
+    words = parse_description(f"{action} {colour} {speed}", lex)
+    choices = [(w, lex.synonym[w]) for w in reversed(words)]   # speed, colour, action
     return [tuple(reversed(c)) for c in itertools.product(*choices)]
 
 
-def encode(words: tuple[str, ...] | list[str]) -> torch.Tensor:
+def encode(words: tuple[str, ...] | list[str],
+           lexicon: Lexicon | None = None) -> torch.Tensor:
     """Word list -> index tensor with ``<BOS/EOS>`` at both ends, shape (len + 2,).
 
     The words are vocabulary words as written (``move-up``, not ``move up``); a string,
     or any other word, raises :class:`LanguageError` (:func:`tokenize` splits text).
     """
+    lex = lexicon or DEFAULT_LEXICON
     if not isinstance(words, (list, tuple)):
         raise LanguageError(f"encode takes a list of vocabulary words, e.g. "
                             f"['push', 'red', 'slowly']; got {type(words).__name__} "
                             f"{words!r:.80} (tokenize(text) splits text into words)")
     for position, word in enumerate(words):
-        if not isinstance(word, str) or word not in WORD_INDEX or word == BOS_EOS:
-            vocab = ", ".join(w for w in VOCABULARY if w != BOS_EOS)
+        if not isinstance(word, str) or word not in lex.word_index or word == BOS_EOS:
+            vocab = ", ".join(w for w in lex.vocabulary if w != BOS_EOS)
             raise LanguageError(f"encode got {word!r:.80} at position {position}, not "
                                 f"a word of the vocabulary: {vocab}")
-    return torch.tensor([0] + [WORD_INDEX[w] for w in words] + [0])
+    return torch.tensor([0] + [lex.word_index[w] for w in words] + [0])
 
 
 def one_hot(indices: torch.Tensor, dim: int = len(VOCABULARY)) -> torch.Tensor:
@@ -167,25 +265,25 @@ def one_hot(indices: torch.Tensor, dim: int = len(VOCABULARY)) -> torch.Tensor:
     return torch.nn.functional.one_hot(indices.long(), dim).float()
 
 
-def decode(indices: torch.Tensor | list[int]) -> str:
+def decode(indices: torch.Tensor | list[int], lexicon: Lexicon | None = None) -> str:
     """Generated word indices (or one-hot / probability rows) -> text.
 
     Reading stops at the first ``<BOS/EOS>``, so an output of ``<EOS>`` alone gives ``""``.
     Anything else (an index outside 0-22, a fraction, text, rows of another width)
     raises :class:`LanguageError` naming it.
     """
-    t = _word_indices(indices)
+    vocabulary = (lexicon or DEFAULT_LEXICON).vocabulary
+    t = _word_indices(indices, len(vocabulary))
     words = []
     for i in t.tolist():
         if i == 0:
             break
-        words.append(VOCABULARY[i])
+        words.append(vocabulary[i])
     return " ".join(words)
 
 
-def _word_indices(indices) -> torch.Tensor:
-    """:func:`decode`'s input checked: 1-D integer indices 0-22, or a LanguageError."""
-    n = len(VOCABULARY)
+def _word_indices(indices, n: int) -> torch.Tensor:
+    """:func:`decode`'s input checked: 1-D integer indices 0 to n-1 (n words), or a LanguageError."""
     wanted = (f"decode takes word indices (whole numbers 0-{n - 1}) or rows of "
               f"{n} scores (steps, {n})")
     if isinstance(indices, (str, bytes)):

@@ -15,6 +15,9 @@ Deviation from paper: with ``time_stride`` k (2 in the book) one step of the
 action LSTMs covers k time steps: the encoder reads every k-th step, x_0, x_k,
 ...; the decoder reads v_t and writes [ĵ_{t+1}; ...; ĵ_{t+k}], every pose.
 Half the LSTM steps.
+
+``PGAE(cfg, lexicon=...)`` builds the model for a larger vocabulary (not from
+the paper: :func:`pgae_lite.world.with_colour`); the default is the paper's 23 words.
 """
 from __future__ import annotations
 
@@ -23,7 +26,7 @@ from torch import nn
 
 from .config import ModelConfig
 from .data import JOINT_DIM, VISION_DIM
-from .language import INPUT_DIM, VOCABULARY
+from .language import DEFAULT_LEXICON, VOCABULARY, Lexicon
 from .layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
 from .signals import SignalBatch
 
@@ -48,16 +51,25 @@ def embedding_init_(rnn: nn.Module) -> None:
 
 
 class LanguageEncoder(nn.Module):
-    """LSTM over one-hot tokens (signal first); f = final [c; h] of every layer."""
+    """LSTM over one-hot tokens (signal first); f = final [c; h] of every layer.
 
-    def __init__(self, cfg: ModelConfig):
+    The tokens are those of :func:`pgae_lite.signals.make_batch`: the signal s first, as
+    token 23 + s, then word indices. With a lexicon of V > 23 words the signal's one-hot
+    dimension is V + s (the words' come first), so the first token moves by V - 23.
+    """
+
+    def __init__(self, cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
-        self.rnn = make_recurrent(cfg.cell, INPUT_DIM, cfg.units, cfg.layers)
+        self.input_dim = lexicon.input_dim                  # 28 for the paper's words
+        self.signal_shift = lexicon.size - len(VOCABULARY)    # 0 for the paper's
+        self.rnn = make_recurrent(cfg.cell, self.input_dim, cfg.units, cfg.layers)
         embedding_init_(self.rnn)
         self.output_dim = cfg.state_dim
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
-        x = nn.functional.one_hot(tokens, INPUT_DIM).float()   # (B, 5, 28)
+        if self.signal_shift:                                   # signal 23 + s -> V + s
+            tokens = torch.cat([tokens[:, :1] + self.signal_shift, tokens[:, 1:]], 1)
+        x = nn.functional.one_hot(tokens, self.input_dim).float()   # (B, 5, 28)
         _, state = self.rnn(x, lengths)
         return state_to_vector(state)                           # (B, 400)
 
@@ -65,11 +77,16 @@ class LanguageEncoder(nn.Module):
 LANGUAGE_ENCODERS = ("lstm", "pretrained")
 
 
-def make_language_encoder(cfg: ModelConfig) -> nn.Module:
+def make_language_encoder(cfg: ModelConfig,
+                          lexicon: Lexicon = DEFAULT_LEXICON) -> nn.Module:
     """The language encoder ``cfg.language_encoder`` names; it has an ``output_dim``."""
     if cfg.language_encoder == "lstm":
-        return LanguageEncoder(cfg)
+        return LanguageEncoder(cfg, lexicon)
     if cfg.language_encoder == "pretrained":
+        if lexicon != DEFAULT_LEXICON:
+            raise ValueError("the pretrained language encoder (PGAE-BERT) reads the "
+                             "paper's 23 words only; use language_encoder='lstm' with "
+                             "a larger lexicon")
         # Imported here: transformers loads only when PGAE-BERT is used.
         from .pretrained import PretrainedLanguageEncoder
         return PretrainedLanguageEncoder(cfg.pretrained_model)
@@ -95,15 +112,19 @@ class ActionEncoder(nn.Module):
 
 
 class LanguageDecoder(nn.Module):
-    """Generates w_1..w_4 from h, starting from <BOS>; softmax over the 23 words."""
+    """Generates w_1..w_4 from h, starting from <BOS>; softmax over the 23 words.
 
-    def __init__(self, cfg: ModelConfig):
+    (Over the lexicon's words, when it has more.)
+    """
+
+    def __init__(self, cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
+        self.words = words = lexicon.size                       # 23 for the paper's
         self.layers = cfg.layers
         self.init_state = nn.Linear(cfg.hidden, cfg.state_dim)   # initial state = W h + b
-        self.rnn = make_recurrent(cfg.cell, WORDS, cfg.units, cfg.layers)
+        self.rnn = make_recurrent(cfg.cell, words, cfg.units, cfg.layers)
         embedding_init_(self.rnn)
-        self.out = nn.Linear(cfg.units, WORDS)
+        self.out = nn.Linear(cfg.units, words)
 
     def forward(self, h: torch.Tensor, target: torch.Tensor | None = None, steps: int = 4,
                 feedback: str = "greedy") -> torch.Tensor:
@@ -114,10 +135,11 @@ class LanguageDecoder(nn.Module):
         feeds the argmax word back, ``"soft"`` the softmax (authors' code).
         """
         state = vector_to_state(self.init_state(h), self.layers)
-        bos = h.new_zeros(h.shape[0], 1, WORDS)
+        bos = h.new_zeros(h.shape[0], 1, self.words)
         bos[..., 0] = 1.0
         if target is not None:
-            x = torch.cat([bos, nn.functional.one_hot(target[:, :-1], WORDS).float()], 1)  # (B, 4, 23)
+            words = nn.functional.one_hot(target[:, :-1], self.words).float()
+            x = torch.cat([bos, words], 1)                      # (B, 4, 23)
             y, _ = self.rnn(x, None, state)
             return self.out(y)
         x, logits = bos[:, 0], []
@@ -126,7 +148,7 @@ class LanguageDecoder(nn.Module):
             logit = self.out(y)                                 # (B, 23)
             logits.append(logit)
             x = (logit.softmax(-1) if feedback == "soft"
-                 else nn.functional.one_hot(logit.argmax(-1), WORDS).float())
+                 else nn.functional.one_hot(logit.argmax(-1), self.words).float())
         return torch.stack(logits, 1)
 
 
@@ -223,15 +245,21 @@ class ActionDecoder(nn.Module):
 
 
 class PGAE(nn.Module):
-    """The whole model: two encoders, the GMU, two decoders."""
+    """The whole model: two encoders, the GMU, two decoders.
 
-    def __init__(self, cfg: ModelConfig | None = None):
+    ``lexicon``: the words it reads and writes (default: the paper's 23).
+    """
+
+    def __init__(self, cfg: ModelConfig | None = None,
+                 lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
         self.cfg = cfg or ModelConfig()
-        self.language_encoder = make_language_encoder(self.cfg)   # LSTM (PGAE) or frozen transformer (PGAE-BERT)
+        self.lexicon = lexicon
+        # LSTM (PGAE) or frozen transformer (PGAE-BERT)
+        self.language_encoder = make_language_encoder(self.cfg, lexicon)
         self.action_encoder = ActionEncoder(self.cfg)
         self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden)
-        self.language_decoder = LanguageDecoder(self.cfg)
+        self.language_decoder = LanguageDecoder(self.cfg, lexicon)
         self.action_decoder = ActionDecoder(self.cfg)
 
     def encode(self, batch: SignalBatch, language: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:

@@ -16,7 +16,9 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
 
 from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from .config import TRAININGS, get_profile, profile_name, training_profile
@@ -44,7 +46,14 @@ def trained_cae(profile: str | None = None, device: str | None = None, progress:
     prof = get_profile(profile)                  # None: the default profile (config.profile_name)
     data, cae = prof.data, prof.cae
     generate(data, workers=workers, progress=progress)
-    path = cae_path(data, cae)
+    return cached_cae(cae_path(data, cae), cae,
+                      lambda: training_frames(data, cae.frame_stride), device, progress)
+
+
+def cached_cae(path: Path, cae: CAEConfig, frames: Callable[[], np.ndarray],
+               device: str | None = None, progress: bool = True
+               ) -> tuple[ChannelSeparatedCAE, list[dict]]:
+    """The CAE cached at ``path``, else one trained with ``cae`` on ``frames()``."""
     if path.exists():  # the path is keyed by both configs: no need to read the frames again
         try:
             model, ckpt = load_cae(path, device)
@@ -54,7 +63,7 @@ def trained_cae(profile: str | None = None, device: str | None = None, progress:
         except Exception as e:  # a damaged or foreign file: train again rather than use it
             warnings.warn(f"{path}: cannot use this cached CAE ({e}); training it again", stacklevel=2)
             path.unlink()
-    return train_cae(training_frames(data, cae.frame_stride), cae, device, progress, out_path=path)
+    return train_cae(frames(), cae, device, progress, out_path=path)
 
 
 def simulated_dataset(profile: str | None = None, device: str | None = None, progress: bool = True,
@@ -63,13 +72,22 @@ def simulated_dataset(profile: str | None = None, device: str | None = None, pro
     prof = get_profile(profile)
     data, cae_config = prof.data, prof.cae
     path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
+
+    def make() -> PGAEDataset:
+        model, _ = trained_cae(prof.name, device, progress, workers)
+        return to_dataset(data, lambda frames: extract_features(model, frames),
+                          progress)
+    return cached_dataset(path, make)
+
+
+def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
+    """The dataset cached at ``path``, else ``make()``'s, saved there."""
     if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite
         try:
             return PGAEDataset.load(path, fingerprint=path.stem)
         except DataFormatError as e:
             warnings.warn(f"{e}; computing the features again", stacklevel=2)
-    model, _ = trained_cae(prof.name, device, progress, workers)
-    dataset = to_dataset(data, lambda frames: extract_features(model, frames), progress)
+    dataset = make()
     path.parent.mkdir(parents=True, exist_ok=True)
     dataset.save(path, fingerprint=path.stem)
     return dataset
@@ -106,4 +124,5 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path"]
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path", "cached_cae",
+           "cached_dataset"]

@@ -30,6 +30,7 @@ ACTION_IN = (True, False, True, True, False)     # does it feed the whole action
 LANG_OUT = (True, False, False, True, True)      # must it produce the description?
 EOS = 0
 SIGNAL_TOKEN = len(VOCABULARY)                   # signal s is input token 23 + s
+# (a PGAE with a lexicon of V words moves it to V + s itself: pgae.LanguageEncoder)
 
 
 @dataclass

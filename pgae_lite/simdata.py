@@ -31,7 +31,7 @@ import os
 import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from multiprocessing import get_context
 from pathlib import Path
 from typing import Callable, Iterator
@@ -41,10 +41,10 @@ from tqdm.auto import tqdm
 
 from .data import PGAEDataset, from_recordings
 from .errors import PGAELiteError
-from .patterns import Pattern
 from .sim.record import Episode, SimConfig, record_episode
 from .utils import (array_digest, atomic_write, atomic_write_text, cache_dir,
                     config_digest)
+from .world import DEFAULT_WORLD, World
 
 #: Bump when the simulator changes what it records: old caches are then not reused.
 GENERATOR_VERSION = 4
@@ -54,15 +54,35 @@ MIN_JOBS_PER_WORKER = 24      # below this many episodes per process, one proces
 
 @dataclass(frozen=True)
 class DatasetConfig:
-    """What to record: which patterns, how many variations of each, from which seed."""
+    """What to record: which patterns, how many variations of each, from which seed.
+
+    ``world``: a world with more colours and patterns
+    (:func:`pgae_lite.world.with_colour`); None is the paper's, and leaves the cache
+    key as it always was.
+    """
 
     variations: int = 6
-    patterns: tuple[int, ...] | None = None   # None: all 144
+    patterns: tuple[int, ...] | None = None   # None: all 144 (all of the world's)
     base_seed: int = 0
     sim: SimConfig = field(default_factory=SimConfig)
+    world: World | None = None
+
+    @property
+    def the_world(self) -> World:
+        return self.world or DEFAULT_WORLD
 
     def pattern_list(self) -> list[int]:
-        return list(range(144)) if self.patterns is None else sorted(self.patterns)
+        if self.patterns is None:
+            return list(range(self.the_world.n_patterns))
+        return sorted(self.patterns)
+
+    def to_dict(self) -> dict:
+        """Plain values; ``world`` only when given (the paper's key stays the same)."""
+        d = asdict(replace(self, world=None))
+        d.pop("world")
+        if self.world is not None:
+            d["world"] = self.world.to_dict()
+        return d
 
     def episodes(self) -> list[tuple[int, int]]:
         """(pattern, variation) of every episode, in a fixed order."""
@@ -70,7 +90,7 @@ class DatasetConfig:
 
     def key(self) -> str:
         """Short digest of the config (and the generator version): the cache folder's name."""
-        return config_digest({"version": GENERATOR_VERSION, **asdict(self)})
+        return config_digest({"version": GENERATOR_VERSION, **self.to_dict()})
 
 
 class CorruptEpisodeError(PGAELiteError, RuntimeError):
@@ -112,8 +132,11 @@ def save_episode(path: Path, ep: Episode) -> None:
         np.savez_compressed(f, digest=np.array(digest), **arrays)
 
 
-def load_episode_file(path: Path) -> Episode:
-    """Read and check one episode file; :class:`CorruptEpisodeError` if it is damaged."""
+def load_episode_file(path: Path, world: World | None = None) -> Episode:
+    """Read and check one episode file; :class:`CorruptEpisodeError` if it is damaged.
+
+    ``world``: the world whose patterns it may hold (default: the paper's).
+    """
     try:
         with np.load(path, allow_pickle=False) as f:
             arrays = {k: f[k] for k in ("joints", "images", "images_opposite", "displacement", "meta")}
@@ -125,7 +148,7 @@ def load_episode_file(path: Path) -> Episode:
     if array_digest(arrays) != digest:
         raise CorruptEpisodeError(f"{path}: contents do not match their digest")
     pattern, variation, seed, attempts = (int(x) for x in arrays["meta"])
-    steps = Pattern.from_number(pattern).steps
+    steps = (world or DEFAULT_WORLD).pattern(pattern).steps
     if (arrays["joints"].shape != (steps, 5) or arrays["images"].shape != (steps, *IMAGE_SHAPE)
             or arrays["images_opposite"].shape != (steps, *IMAGE_SHAPE)):
         raise CorruptEpisodeError(f"{path}: unexpected shapes {arrays['joints'].shape}, {arrays['images'].shape}")
@@ -138,11 +161,11 @@ def load_episode_file(path: Path) -> Episode:
                    images_opposite=arrays["images_opposite"], displacement=arrays["displacement"], valid=True)
 
 
-def _record_and_save(args: tuple[int, int, SimConfig, int, str]) -> dict:
+def _record_and_save(args: tuple[int, int, SimConfig, int, str, World]) -> dict:
     """Worker: record one episode, save it, return its manifest entry."""
-    pattern, variation, sim_config, base_seed, folder = args
+    pattern, variation, sim_config, base_seed, folder, world = args
     t0 = time.perf_counter()
-    ep = record_episode(pattern, variation, sim_config, base_seed)
+    ep = record_episode(pattern, variation, sim_config, base_seed, world)
     path = Path(folder) / f"{episode_name(pattern, variation)}.npz"
     save_episode(path, ep)
     return {"name": episode_name(pattern, variation), "seed": ep.seed, "attempts": ep.attempts,
@@ -191,7 +214,8 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
     t0 = time.perf_counter()
     folder = episode_folder(config)
     folder.mkdir(parents=True, exist_ok=True)
-    _write_json(folder / "config.json", {"version": GENERATOR_VERSION, **asdict(config)})
+    _write_json(folder / "config.json",
+                {"version": GENERATOR_VERSION, **config.to_dict()})
     manifest = _read_manifest(folder)
     todo, corrupt = [], 0
     for p, v in config.episodes():
@@ -204,7 +228,7 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
         if entry is not None and file_digest(path) == entry["digest"]:
             continue
         try:                      # a whole file that never reached the manifest, or a damaged one
-            ep = load_episode_file(path)
+            ep = load_episode_file(path, config.world)
             if entry is not None:
                 raise CorruptEpisodeError(f"{path}: file digest differs from the manifest")
             manifest[name] = {"name": name, "seed": ep.seed, "attempts": ep.attempts,
@@ -214,7 +238,8 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
             corrupt += 1
             manifest.pop(name, None)
             todo.append((p, v))
-    jobs = [(p, v, config.sim, config.base_seed, str(folder)) for p, v in todo]
+    jobs = [(p, v, config.sim, config.base_seed, str(folder), config.the_world)
+            for p, v in todo]
     if workers is None:   # a new worker process takes seconds to start (it imports torch): not worth it for few jobs
         workers = (os.cpu_count() or 1) if len(jobs) >= 2 * MIN_JOBS_PER_WORKER else 1
     workers = max(1, min(workers, len(jobs)))
@@ -253,15 +278,16 @@ def load_episode(config: DatasetConfig, pattern: int, variation: int = 0) -> Epi
     path = episode_folder(config) / f"{episode_name(pattern, variation)}.npz"
     if not path.exists():
         generate(config)
-    return load_episode_file(path)
+    return load_episode_file(path, config.world)
 
 
 def iter_episodes(config: DatasetConfig, split: str | None = None) -> Iterator[Episode]:
     """Every episode of the dataset in order (``split``: ``"train"``, ``"test"`` or all)."""
     generate(config, progress=False)
     for p, v in config.episodes():
-        if split is None or Pattern.from_number(p).is_test == (split == "test"):
-            yield load_episode_file(episode_folder(config) / f"{episode_name(p, v)}.npz")
+        if split is None or config.the_world.pattern(p).is_test == (split == "test"):
+            path = episode_folder(config) / f"{episode_name(p, v)}.npz"
+            yield load_episode_file(path, config.world)
 
 
 def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ...] = ("images", "images_opposite")
@@ -276,7 +302,9 @@ def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarra
     """The episodes as a :class:`~pgae_lite.data.PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
     episodes = tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
                     unit="ep", disable=not progress)
-    return from_recordings(((Pattern.from_number(ep.pattern), f"sim/{episode_name(ep.pattern, ep.variation)}",
+    world = config.the_world
+    return from_recordings(((world.pattern(ep.pattern),
+                             f"sim/{episode_name(ep.pattern, ep.variation)}",
                              ep.joints, features(ep.images), features(ep.images_opposite)) for ep in episodes),
                            source=f"simulated:{config.key()}")
 

@@ -159,7 +159,7 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
         torch.set_rng_state(ckpt["torch_rng"])
         start_epoch, history, elapsed = ckpt["epoch"], ckpt["history"], ckpt["seconds"]
 
-    weights = word_weights().to(device)
+    weights = word_weights(getattr(model, "lexicon", None)).to(device)   # model's words
     t0 = time.perf_counter() - elapsed
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)

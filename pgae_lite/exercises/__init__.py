@@ -7,7 +7,8 @@ A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacem
 Sec. 4: the vocabulary, and our simulator's cube colours.
 
 - ``result``  :class:`~pgae_lite.exercises.result.CheckResult` and how a check runs and compares student code
-- ``world``   chapters 01-03: ``check_vocabulary``, ``check_colour``
+- ``world``   chapters 01-03: ``check_vocabulary``, ``check_colour``; the guided project
+              "Teach NICO a new colour": ``check_new_colour``
 - ``model``   chapters 04-05: ``check_peephole_step``, ``check_lstm_step``, ``check_gmu``,
               ``check_bottleneck``, ``check_signal_probs``
 
@@ -15,7 +16,8 @@ Every check is importable from here, e.g. ``from pgae_lite.exercises import chec
 """
 from .model import check_bottleneck, check_gmu, check_lstm_step, check_peephole_step, check_signal_probs
 from .result import CheckResult
-from .world import check_colour, check_vocabulary
+from .world import check_colour, check_new_colour, check_vocabulary
 
-__all__ = ["CheckResult", "check_vocabulary", "check_colour", "check_peephole_step", "check_lstm_step", "check_gmu",
+__all__ = ["CheckResult", "check_vocabulary", "check_colour", "check_new_colour",
+           "check_peephole_step", "check_lstm_step", "check_gmu",
            "check_bottleneck", "check_signal_probs"]

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..patterns import NUMBERING, Pattern
+from ..world import DEFAULT_WORLD, EXTENSION_NUMBERING, World
 from .actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
                       check_action, plan_action, sample_variation, world_direction)
 from .robot import JOINT_LIMITS, JOINT_NAMES, Robot
@@ -118,30 +119,38 @@ class Execution:
 
 
 def episode_seed(pattern: int, variation: int, base_seed: int = 0, attempt: int = 0) -> int:
-    """The integer seed of one attempt: ((base_seed * 144 + pattern) * 100 + variation) * 100 + attempt."""
+    """The integer seed of one attempt: ((base_seed * 144 + pattern) * 100 + variation) * 100 + attempt.
+
+    Patterns beyond 143 (:mod:`pgae_lite.world`) reuse base_seed + 1's seeds (no clash).
+    """
     return ((base_seed * 144 + pattern) * 100 + variation) * 100 + attempt
 
 
-def _validate(pattern: int, variation: int, base_seed: int) -> Pattern:
-    if not isinstance(pattern, (int, np.integer)) or not 0 <= pattern < 144:
-        raise ValueError(f"pattern must be an integer 0-143 ({NUMBERING}), "
-                         f"got {pattern!r}")
+def _validate(pattern: int, variation: int, base_seed: int,
+              world: World = DEFAULT_WORLD) -> Pattern:
+    last = world.n_patterns - 1
+    if not isinstance(pattern, (int, np.integer)) or not 0 <= pattern <= last:
+        extended = f"; from 144: {EXTENSION_NUMBERING}" if last >= 144 else ""
+        raise ValueError(f"pattern must be an integer 0-{last} "
+                         f"({NUMBERING}{extended}), got {pattern!r}")
     if not isinstance(variation, (int, np.integer)) or not 0 <= variation < 100:
         raise ValueError(f"variation must be an integer 0-99 (the dataset uses 0-5), got {variation!r}")
     if not isinstance(base_seed, (int, np.integer)) or base_seed < 0:
         raise ValueError(f"base_seed must be a non-negative integer, got {base_seed!r}")
-    return Pattern.from_number(int(pattern))
+    return world.pattern(int(pattern))
 
 
 def scene_layout(pattern: int, variation: int = 0, base_seed: int = 0,
-                 config: SimConfig = SimConfig()) -> SceneLayout:
-    """Cube colours and (jittered) positions of one pattern and variation."""
-    pat = _validate(pattern, variation, base_seed)
+                 config: SimConfig = SimConfig(),
+                 world: World = DEFAULT_WORLD) -> SceneLayout:
+    """Cube colours and (jittered) positions of a pattern and variation of ``world``."""
+    pat = _validate(pattern, variation, base_seed, world)
     rng = np.random.default_rng([episode_seed(pattern, variation, base_seed), 0])   # stream 0: the layout
     jitter = rng.uniform(-config.cube_jitter, config.cube_jitter, size=(2, 2))       # (cube, xy)
     return SceneLayout(pat.left, pat.right,
                        left_xy=(TABLE_CENTRE_X + jitter[0, 0], CUBE_Y + jitter[0, 1]),
-                       right_xy=(TABLE_CENTRE_X + jitter[1, 0], -CUBE_Y + jitter[1, 1]))
+                       right_xy=(TABLE_CENTRE_X + jitter[1, 0], -CUBE_Y + jitter[1, 1]),
+                       palette=world.rgba or None)
 
 
 class Simulation:
@@ -154,11 +163,14 @@ class Simulation:
         sim.cube_displacement(), sim.check()  # (2, 3) metres; ActionCheck for the pattern
 
     Each :meth:`reset` rebuilds the world (bit-reproducible); ``agent="opposite"``
-    makes the opposite agent act while NICO sits still.
+    makes the opposite agent act while NICO sits still. ``world`` (default: the
+    paper's) gives the patterns' colours (:mod:`pgae_lite.world`).
     """
 
-    def __init__(self, config: SimConfig = SimConfig()) -> None:
+    def __init__(self, config: SimConfig = SimConfig(),
+                 world: World = DEFAULT_WORLD) -> None:
         self.config = config
+        self.world = world
         self.scene: Scene | None = None
         self.pattern: Pattern | None = None
         self.variation: int | None = None
@@ -169,14 +181,15 @@ class Simulation:
         if agent not in AGENTS:
             raise ValueError(f"unknown agent {agent!r}; the agents are: {', '.join(AGENTS)}")
         cfg = self.config
-        layout = scene_layout(pattern, variation, base_seed, cfg)
+        layout = scene_layout(pattern, variation, base_seed, cfg, self.world)
         if self.scene is None:
             self.scene = Scene(layout, actor=agent, time_step=1.0 / cfg.physics_hz,
                                hand_friction=cfg.hand_friction, solver_iterations=cfg.solver_iterations,
                                image_size=(cfg.image_height, cfg.image_width))
         else:
             self.scene.rebuild(layout, agent)
-        self.pattern, self.variation, self.agent = Pattern.from_number(int(pattern)), int(variation), agent
+        self.pattern = self.world.pattern(int(pattern))
+        self.variation, self.agent = int(variation), agent
         return self.scene.render() if render else None
 
     @property
@@ -242,13 +255,14 @@ class Simulation:
 
 
 @functools.lru_cache(maxsize=4)
-def _simulation(config: SimConfig) -> Simulation:
-    """One Simulation (one physics server) per config and process, reused across episodes."""
-    return Simulation(config)
+def _simulation(config: SimConfig, world: World = DEFAULT_WORLD) -> Simulation:
+    """One Simulation (one physics server) per config, world and process, reused."""
+    return Simulation(config, world)
 
 
 def execute_trajectory(joints: np.ndarray, pattern: int, variation: int = 0, config: SimConfig = SimConfig(),
-                       base_seed: int = 0, render: bool = True, agent: str = "nico") -> Execution:
+                       base_seed: int = 0, render: bool = True, agent: str = "nico",
+                       world: World = DEFAULT_WORLD) -> Execution:
     """Drive an agent (default NICO) along any joint trajectory (T, 5) in the scene of a pattern.
 
     The world is the one :func:`record_episode` uses for (pattern, variation,
@@ -256,15 +270,19 @@ def execute_trajectory(joints: np.ndarray, pattern: int, variation: int = 0, con
     result holds the frames, the measured joints, the cube displacement and
     whether the pattern's action succeeded, by the same check as the recordings.
     """
-    sim = _simulation(config)
+    sim = _simulation(config, world)
     sim.reset(pattern, variation, base_seed, agent, render=False)
     return sim.run(joints, render)
 
 
-def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig(), base_seed: int = 0) -> Episode:
-    """Record one episode: NICO acting and the opposite agent acting, both checked (see module docstring)."""
-    _validate(pattern, variation, base_seed)
-    sim = _simulation(config)
+def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig(),
+                   base_seed: int = 0, world: World = DEFAULT_WORLD) -> Episode:
+    """Record one episode: NICO acting and the opposite agent acting, both checked (see module docstring).
+
+    ``world``: patterns beyond 143, their colours (:func:`pgae_lite.world.with_colour`).
+    """
+    pat = _validate(pattern, variation, base_seed, world)
+    sim = _simulation(config, world)
     failures = []
     for attempt in range(config.max_attempts):
         seed = episode_seed(pattern, variation, base_seed, attempt)
@@ -290,7 +308,7 @@ def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig()
                       pattern, variation, seed, info["tracking_error"], info["tracking_error_opposite"])
             return Episode(int(pattern), int(variation), seed, attempt + 1, me.measured.astype(np.float32),
                            me.frames, other.frames, me.displacement.astype(np.float32), True, info)
-    raise RuntimeError(f"pattern {pattern} ({Pattern.from_number(int(pattern)).code}), variation {variation}: "
+    raise RuntimeError(f"pattern {pattern} ({pat.code}), variation {variation}: "
                        f"no valid episode in {config.max_attempts} attempts; last failures: "
                        + " | ".join(failures[-3:]))
 

@@ -77,17 +77,31 @@ def _quiet_client() -> bullet_client.BulletClient:
 
 @dataclass
 class SceneLayout:
-    """Where the cubes are: colours and centres (world frame, metres)."""
+    """Where the cubes are: colours and centres (world frame, metres).
+
+    ``palette``: RGBA of colours beyond :data:`CUBE_RGBA` (a
+    :class:`pgae_lite.world.World`'s ``rgba``), e.g.
+    ``SceneLayout("orange", "blue", palette=world.rgba)``.
+    """
 
     left_colour: str
     right_colour: str
     left_xy: tuple[float, float] = (TABLE_CENTRE_X, CUBE_Y)
     right_xy: tuple[float, float] = (TABLE_CENTRE_X, -CUBE_Y)
+    palette: dict[str, tuple[float, float, float, float]] | None = None
 
     def __post_init__(self) -> None:
+        colours = self.colours
         for c in (self.left_colour, self.right_colour):
-            if c not in CUBE_RGBA:
-                raise ValueError(f"unknown cube colour {c!r}; the colours are: {', '.join(CUBE_RGBA)}")
+            if c not in colours:
+                hint = "" if self.palette else " (a new one needs palette=world.rgba)"
+                raise ValueError(f"unknown cube colour {c!r}; the colours are: "
+                                 f"{', '.join(colours)}{hint}")
+
+    @property
+    def colours(self) -> dict[str, tuple[float, float, float, float]]:
+        """RGBA of every colour this layout may use: the six, then the palette's."""
+        return {**CUBE_RGBA, **(self.palette or {})}
 
 
 class Scene:
@@ -128,7 +142,8 @@ class Scene:
         self.table = self._box((TABLE_X[1] - TABLE_X[0], 2 * TABLE_HALF_WIDTH, TABLE_THICKNESS),
                                ((TABLE_X[0] + TABLE_X[1]) / 2, 0.0, -TABLE_THICKNESS / 2),
                                TABLE_RGBA, mass=0.0, friction=TABLE_FRICTION)
-        self.cubes = [self._box((CUBE_SIZE,) * 3, (x, y, CUBE_SIZE / 2), CUBE_RGBA[colour],
+        rgba = layout.colours
+        self.cubes = [self._box((CUBE_SIZE,) * 3, (x, y, CUBE_SIZE / 2), rgba[colour],
                                 mass=CUBE_MASS, friction=CUBE_FRICTION)
                       for colour, (x, y) in ((layout.left_colour, layout.left_xy),
                                              (layout.right_colour, layout.right_xy))]
