@@ -74,6 +74,7 @@ class Benchmark:
 
     def __init__(self, name: str, doc: str | None = None, seeds: list[int] | None = None):
         self.name, self.t0 = name, time.perf_counter()
+        self.commit = commit()      # the code measured: taken at the start, a later checkout cannot change it
         self.parser = argparse.ArgumentParser(description=doc,
                                               formatter_class=argparse.RawDescriptionHelpFormatter)
         self.parser.add_argument("--threads", type=int, default=None,
@@ -104,7 +105,7 @@ class Benchmark:
         report = {"benchmark": self.name,
                   "command": " ".join(["python", shlex.quote(os.path.relpath(sys.argv[0], ROOT))]
                                       + [shlex.quote(a) for a in sys.argv[1:]]),
-                  "commit": commit(),
+                  "commit": self.commit,
                   "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
                   "machine": machine(args.threads), "profile": args.profile, "seeds": args.seeds,
                   "seconds": round(time.perf_counter() - self.t0, 1), **fields, "data": data}
