@@ -28,7 +28,7 @@ from .language import SIGNALS, word_weights
 from .pgae import PGAE
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
 from .utils import (CheckpointMismatchError, default_device, folder_lock, load_torch,
-                    one_cpu_thread, save_torch)
+                    save_torch)
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.
@@ -111,16 +111,14 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     second run there fail (:class:`~pgae_lite.utils.FolderBusyError`).
     ``callback(epoch, model, record)``, if given, is called after every epoch
     (e.g. to evaluate along the way). A NaN or infinite loss stops the run
-    (:class:`NonFiniteLossError`, naming the epoch and the batch). On the CPU it
-    trains on one thread (:func:`~pgae_lite.utils.one_cpu_thread`).
+    (:class:`NonFiniteLossError`, naming the epoch and the batch).
     """
     device = torch.device(device) if device else default_device()
     args = (dataset, profile, out_dir, device, progress, model, callback)
-    with one_cpu_thread(device):
-        if out_dir is None:
-            return _train(*args)
-        with folder_lock(out_dir):
-            return _train(*args)
+    if out_dir is None:
+        return _train(*args)
+    with folder_lock(out_dir):
+        return _train(*args)
 
 
 def _train(dataset: PGAEDataset, profile: Profile | str | None,

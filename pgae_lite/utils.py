@@ -5,7 +5,6 @@ What several modules need and none of them owns. It imports nothing from
 
 - :func:`cache_dir`: the root of every cache (``$PGAE_LITE_CACHE``);
 - :func:`default_device`: CUDA when present, else the CPU;
-- :func:`one_cpu_thread`: a training runs on one CPU thread, then the threads are restored;
 - :func:`atomic_path`, :func:`atomic_write`, :func:`atomic_write_text`: a file
   is written under a temporary name beside its place, then renamed onto it in
   one step, so a reader (or a crash) never meets half a file;
@@ -64,24 +63,6 @@ def cache_dir() -> Path:
 def default_device() -> torch.device:
     """CUDA when present, else the CPU."""
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
-
-
-@contextlib.contextmanager
-def one_cpu_thread(device: torch.device) -> Iterator[None]:
-    """On the CPU, run the block on one torch thread, then restore the number there was; elsewhere, nothing.
-
-    PGAE's matrices are small (LSTMs of 100 units, batches of 16): threads spend
-    more time meeting than multiplying. On a 2-core CPU one epoch of the book
-    recipe is faster on one thread than on two (``benchmarks/profile_epoch.py``,
-    ``results/profile_epoch*.json``).
-    """
-    threads = torch.get_num_threads()
-    if torch.device(device).type == "cpu":
-        torch.set_num_threads(1)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(threads)
 
 
 def config_digest(obj) -> str:

@@ -31,20 +31,6 @@ def _same_weights(a, b) -> bool:
 
 
 # --------------------------------------------------------------------------- learning
-def test_trains_on_one_cpu_thread_and_restores_the_threads(toy_short):
-    """On the CPU an epoch runs on one thread (faster here: profile_epoch); the caller's count comes back."""
-    before = torch.get_num_threads()
-    torch.set_num_threads(2)
-    seen = []
-    try:
-        train(toy_short, tiny_profile(epochs=2), progress=False, device="cpu",
-              callback=lambda epoch, model, record: seen.append(torch.get_num_threads()))
-        assert seen == [1, 1]
-        assert torch.get_num_threads() == 2
-    finally:
-        torch.set_num_threads(before)
-
-
 def test_learns_a_handful_of_samples(toy_short):
     """12 samples: the loss falls, joints are fitted, and <EOS> is learnt for execute / repeat action.
 
