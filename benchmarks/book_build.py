@@ -15,6 +15,7 @@ Writes results/book_build.json.
 import os
 import shutil
 import subprocess
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -34,7 +35,9 @@ env = dict(os.environ, PGAE_LITE_PROFILE=args.profile)
 if args.fresh_cache:
     env["PGAE_LITE_CACHE"] = tempfile.mkdtemp(prefix="pgae-book-cache-")
 t0 = time.perf_counter()
-done = subprocess.run(["jupyter-book", "build", ".", "-W", "-n", "--keep-going"], cwd=root, env=env)
+# this environment's jupyter-book (beside its python), whether or not it is on PATH
+book_cli = shutil.which("jupyter-book", path=str(Path(sys.executable).parent)) or "jupyter-book"
+done = subprocess.run([book_cli, "build", ".", "-W", "-n", "--keep-going"], cwd=root, env=env)
 seconds = time.perf_counter() - t0
 
 cache = get_cache(root / "_build" / ".jupyter_cache")
