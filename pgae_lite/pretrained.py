@@ -63,7 +63,7 @@ _LOADED: dict[str, Transformer] = {}   # one copy per model name, shared by ever
 
 
 def model_name(name: str | None) -> str:
-    """``name``, or :data:`DEFAULT_MODEL` for None; refused: empty, or not a string."""
+    """``name``, or ``DEFAULT_MODEL`` (the shipped model) for None; refused: empty, or not a string."""
     instance_of("the pretrained model", name, str, "a Hugging Face name or a folder",
                 optional=True)
     if name is not None and not name.strip():
