@@ -32,7 +32,7 @@ def read_rows(path: Path, width: int) -> np.ndarray:
     """The numbers of a text file, ``width`` per row, as float32 (rows, width).
 
     Blank lines are skipped; every other line must hold exactly ``width``
-    finite numbers, else :class:`DataFormatError` names the file and the line.
+    finite numbers, else :class:`~pgae_lite.data.DataFormatError` names the file and the line.
     """
     if not path.is_file():
         raise DataFormatError(f"missing file {path}: every sample needs the same file "
@@ -88,7 +88,7 @@ def _lines(path: Path) -> list[int]:
 
 def check_range(path: Path, values: np.ndarray, lo: float, hi: float,
                 what: str) -> None:
-    """:class:`DataFormatError` naming the line if a value lies outside [lo, hi]."""
+    """:class:`~pgae_lite.data.DataFormatError` naming the line if a value lies outside [lo, hi]."""
     bad = (values < lo) | (values > hi)
     if bad.any():
         number, column = _first(bad, _lines(path))
