@@ -20,8 +20,8 @@ import torch
 
 from .data import Normaliser, PGAEDataset
 from .errors import ArgumentError
-from .language import (DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, VOCABULARY, decode,
-                       is_correct, normalise_signal)
+from .language import (DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, decode, is_correct,
+                       normalise_signal)
 from .pgae import PGAE
 from .signals import LANG_OUT, make_batch, signal_ids
 from .validate_api import instance_of, positive_number, whole_number

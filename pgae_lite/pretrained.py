@@ -33,7 +33,7 @@ from .errors import ArgumentError, PGAELiteError
 from .language import (SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
                        normalise_signal)
 from .signals import EOS, LANG_IN, SIGNAL_TOKEN
-from .utils import atomic_path, cache_dir
+from .utils import cache_dir, save_torch
 from .validate_api import instance_of, shown
 
 # Deviation from paper: the default is all-MiniLM-L6-v2 (22M parameters, 384-d), not
@@ -314,9 +314,8 @@ class PretrainedLanguageEncoder(nn.Module):
         t0 = time.perf_counter()
         table = self._run_transformer(self.texts)
         seconds = time.perf_counter() - t0
-        path.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_path(path) as tmp:   # a crash never leaves half a file
-            torch.save({**self._cache_header(), "model": self.name, "embeddings": table, "seconds": seconds}, tmp)
+        save_torch({**self._cache_header(), "model": self.name, "embeddings": table,
+                    "seconds": seconds}, path)        # atomic: a crash never leaves half a file
         return table, "computed", seconds
 
     def extra_repr(self) -> str:
