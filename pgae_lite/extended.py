@@ -142,7 +142,7 @@ def load_pgae(path: str | Path, world: World, device: str | None = None
 
     path = Path(path)
     ckpt = load_checkpoint(path / CHECKPOINT if path.is_dir() else path)
-    model = PGAE(ModelConfig(**ckpt["profile"]["model"]), world.lexicon)
+    model = PGAE(ModelConfig.from_checkpoint(ckpt["profile"]["model"]), world.lexicon)
     try:
         model.load_state_dict(ckpt["model"])
     except RuntimeError as e:                     # the first mismatch, e.g. the words

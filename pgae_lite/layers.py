@@ -186,17 +186,26 @@ class GatedMultimodalUnit(nn.Module):
     """The GMU bottleneck (Arevalo et al. 2017), paper Sec. 3, "Bottleneck".
 
     Mixes the action and language features per dimension with a learnt gate z.
+    ``normalise_action``: the book recipe's layer normalisation of W_A f_act + b (below).
     """
 
-    def __init__(self, action_dim: int, language_dim: int, hidden_dim: int = 50):
+    def __init__(self, action_dim: int, language_dim: int, hidden_dim: int = 50,
+                 normalise_action: bool = False):
         super().__init__()
         self.action_linear = nn.Linear(action_dim, hidden_dim)
         self.language_linear = nn.Linear(language_dim, hidden_dim)
         self.gate_linear = nn.Linear(action_dim + language_dim, hidden_dim)
+        self.normalise_action = normalise_action
 
     def forward(self, f_action: torch.Tensor, f_language: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """Returns the shared representation h and the gate z, both (batch, hidden)."""
-        a_h = torch.tanh(self.action_linear(f_action))           # A_h = tanh(W_A f_act + b)
+        a = self.action_linear(f_action)                          # W_A f_act + b, (batch, hidden)
+        if self.normalise_action:
+            # Deviation from paper: a is normalised to mean 0, variance 1 over its dimensions before
+            # the tanh. f_act holds the LSTM's unbounded cell states; without this, some seeds push a
+            # so far that tanh saturates for every sample and describe never learns (ModelConfig.gmu_norm).
+            a = nn.functional.layer_norm(a, a.shape[-1:])
+        a_h = torch.tanh(a)                                      # A_h = tanh(W_A f_act + b)
         l_h = torch.tanh(self.language_linear(f_language))       # L_h = tanh(W_L f_lang + b)
         z = torch.sigmoid(self.gate_linear(torch.cat([f_action, f_language], dim=1)))  # z = σ(W_z [f_act; f_lang] + b)
         h = z * a_h + (1 - z) * l_h                              # h = z ⊙ A_h + (1 − z) ⊙ L_h

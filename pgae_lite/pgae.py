@@ -258,7 +258,8 @@ class PGAE(nn.Module):
         # LSTM (PGAE) or frozen transformer (PGAE-BERT)
         self.language_encoder = make_language_encoder(self.cfg, lexicon)
         self.action_encoder = ActionEncoder(self.cfg)
-        self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden)
+        self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden,
+                                       normalise_action=self.cfg.gmu_norm)
         self.language_decoder = LanguageDecoder(self.cfg, lexicon)
         self.action_decoder = ActionDecoder(self.cfg)
 

@@ -282,9 +282,7 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         _check_trained_on(ckpt, fitted, path, dataset.source)
-    # Checkpoints older than ModelConfig.joint_feedback were trained with the paper's feedback.
-    # checkpoints from before a setting existed: the value they were trained with
-    model = PGAE(ModelConfig(**{"joint_feedback": "predicted", "time_stride": 1, **ckpt["profile"]["model"]}))
+    model = PGAE(ModelConfig.from_checkpoint(ckpt["profile"]["model"]))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt

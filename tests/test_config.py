@@ -76,3 +76,15 @@ def test_recipes_live_here():
     assert (bert.data, bert.cae, bert.chapters) == (smoke.data, smoke.cae, smoke.chapters)   # only the recipe changes
     views = training_profile(smoke, "PGAE-views")
     assert views.train.opposite_prob == 0.5 and smoke.train.opposite_prob == 0.0
+
+
+def test_gmu_norm_is_the_book_recipe_and_not_the_papers():
+    from pgae_lite.config import ModelConfig, get_profile
+    from pgae_lite.pgae import PGAE
+    assert ModelConfig().gmu_norm and get_profile("book").model.gmu_norm
+    assert not get_profile("paper").model.gmu_norm
+    assert PGAE(ModelConfig(units=8)).gmu.normalise_action
+    # a checkpoint saved before the setting existed was trained without it
+    old = {k: v for k, v in ModelConfig(units=8).__dict__.items() if k != "gmu_norm"}
+    assert not ModelConfig.from_checkpoint(old).gmu_norm
+    assert ModelConfig.from_checkpoint({**old, "gmu_norm": True}).gmu_norm

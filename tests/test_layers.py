@@ -187,3 +187,19 @@ def test_gmu_gate_selects_modality():
         gmu.gate_linear.bias.fill_(-50.0)                               # z = 0: language only
     h, _ = gmu(f_act, f_lang)
     torch.testing.assert_close(h, torch.tanh(gmu.language_linear(f_lang)))
+
+
+def test_gmu_normalised_action_against_its_equations():
+    torch.manual_seed(0)
+    gmu = GatedMultimodalUnit(action_dim=6, language_dim=4, hidden_dim=5, normalise_action=True)
+    f_act, f_lang = 1000 * torch.randn(7, 6), torch.randn(7, 4)          # huge, like cell states gone wild
+    a = f_act @ gmu.action_linear.weight.T + gmu.action_linear.bias
+    a = (a - a.mean(1, keepdim=True)) / torch.sqrt(a.var(1, unbiased=False, keepdim=True) + 1e-5)
+    z = _sig(torch.cat([f_act, f_lang], 1) @ gmu.gate_linear.weight.T + gmu.gate_linear.bias)
+    L_h = torch.tanh(gmu.language_linear(f_lang))
+    h, gate = gmu(f_act, f_lang)
+    torch.testing.assert_close(h, z * torch.tanh(a) + (1 - z) * L_h)
+    # whatever the scale of f_act, A_h keeps a spread over its dimensions: never all saturated
+    A_h = torch.tanh(a)
+    assert (A_h.abs() > 0.99).float().mean(1).max() < 1
+    assert not GatedMultimodalUnit(6, 4, 5).normalise_action             # the paper's GMU by default
