@@ -59,9 +59,9 @@ class ModelConfig:
     language_encoder: str = "lstm"
     pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
-    # paper: no normalisation). Measured on our data, seed 1 of the book recipe: without it every describe
-    # came out as one sentence (A_h saturated for all samples); with it, describe on training samples
-    # learnt as fast as on the seeds that never collapsed. The results page has the history.
+    # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
+    # every sample early in training, and describe never learns: one sentence for every action. The
+    # measurements are on the book's results page (A2, "The describe collapse").
     gmu_norm: bool = True
 
     def __post_init__(self):
