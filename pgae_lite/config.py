@@ -122,6 +122,9 @@ class TrainConfig:
     language_weight: float = 1.0        # α
     # Deviation from paper: β = 4 (paper: 1). A 0.5% joint error is a loss of about 1e-4, the words' ~0.1.
     action_weight: float = 4.0          # β
+    # Not in the paper: K > 0 = samples with a description read, half of the time, one of K sentences
+    # saying it in other words (phrasing_bank.py; PGAE-BERT only). 0 = the dataset's descriptions.
+    phrasings: int = 0
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
@@ -133,6 +136,9 @@ class TrainConfig:
                              f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
         self.signal_probs = probs
         check_vision_scaling(self.vision_scaling)
+        if isinstance(self.phrasings, bool) or not hasattr(self.phrasings, "__index__") or self.phrasings < 0:
+            raise ValueError(f"TrainConfig phrasings must be a whole number >= 0 (0: the dataset's "
+                             f"descriptions only); got {self.phrasings!r}")
         for name in ("epochs", "batch_size", "checkpoint_every", "max_train_samples"):
             value = getattr(self, name)
             if name == "max_train_samples" and value is None:
@@ -245,6 +251,8 @@ TRAININGS: dict[str, Training] = {
     "PGAE-BERT": Training(model={"language_encoder": "pretrained"}),
     # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
     "PGAE-views": Training(train={"opposite_prob": 0.5}),
+    # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction (free-form language).
+    "PGAE-BERT-phrasings": Training(model={"language_encoder": "pretrained"}, train={"phrasings": 60}),
 }
 #: row -> (training, evaluated on the opposite agent's actions?)
 ROWS: dict[str, tuple[str, bool]] = {

@@ -159,6 +159,10 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
 
     weights = word_weights(getattr(model, "lexicon", None)).to(device)   # model's words
     t0 = time.perf_counter() - elapsed
+    bank = None                             # its encoding time counts as training time
+    if cfg.phrasings:                       # free-form language (phrasing_bank.py), PGAE-BERT only
+        from .phrasing_bank import PhrasingBank
+        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed)
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:
@@ -179,8 +183,9 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
             batch = make_batch(data, index, signal, alternative, opposite)
             if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
+            language = None if bank is None else bank.features(model, batch, gen)
             out = model(batch, teacher_language=cfg.teacher_language,
-                        feedback="greedy" if cfg.teacher_language else "soft")
+                        feedback="greedy" if cfg.teacher_language else "soft", language=language)
             loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)
             optimiser.zero_grad(set_to_none=True)
             loss.backward()

@@ -1,0 +1,99 @@
+"""Free-form language: the paper's frozen PGAE-BERT against PGAE-BERT trained on phrasings.
+
+    python benchmarks/free_language.py [--trainings PGAE-BERT PGAE-BERT-phrasings] [--seeds 0]
+                                       [--profile book] [--threads 1] [--no-closed]
+
+Both models are trained (or loaded from the cache) on the profile's simulated
+data: ``PGAE-BERT`` reads the dataset's descriptions only; ``PGAE-BERT-phrasings``
+also reads generated sentences that say them in other words
+(:mod:`pgae_lite.phrasing_bank`). Each of the 216 test episodes is told one of
+the 108 held-out paraphrases of its instruction (``pgae_lite/paraphrases.tsv``,
+never trained on), and measured three ways:
+
+- *readback*: the paraphrase with ``repeat language``, no pictures of the action
+  to help: is the generated description (action colour speed) the intended one?
+- *execution*: the paraphrase with ``execute`` in the simulator, open loop (the
+  decoder reads the recorded frames of the right action: it overstates
+  understanding) and closed loop (its own camera);
+- the canonical Table 1 cells of the model on the same data.
+
+The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
+model's training language (the descriptions, plus the phrasings' lexicon for the
+variant). Writes results/free_language.json.
+"""
+from __future__ import annotations
+
+import re
+import time
+
+import numpy as np
+
+from harness import Benchmark
+from pgae_lite.closedloop import variation_of
+from pgae_lite.config import TRAININGS, get_profile
+from pgae_lite.evaluate import evaluate, predict
+from pgae_lite.instructions import execute_paraphrases, paraphrase_of
+from pgae_lite.language import SIGNALS, VOCABULARY
+from pgae_lite.paraphrases import load_paraphrases
+from pgae_lite.phrase_lexicon import LEXICON
+from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.pretrained import input_text
+
+
+def words(text: str) -> set[str]:
+    return set(re.findall(r"[a-z]+(?:-[a-z]+)*", text.lower()))
+
+
+def training_words(training: str) -> set[str]:
+    """Every word of the model's training language: signals, descriptions (and phrasings)."""
+    seen = set().union(*(words(s) for s in SIGNALS), *(words(w) for w in VOCABULARY))
+    if TRAININGS[training].train.get("phrasings"):
+        seen |= set(LEXICON.words())
+    return seen
+
+
+def main() -> None:
+    bench = Benchmark("free_language", __doc__, seeds=[0])
+    bench.parser.add_argument("--trainings", nargs="+", default=["PGAE-BERT", "PGAE-BERT-phrasings"])
+    bench.parser.add_argument("--no-closed", action="store_true", help="open loop only (fast)")
+    args = bench.parse()
+    data = simulated_dataset(args.profile, "cpu", progress=False)
+    cae, _ = trained_cae(args.profile, "cpu", progress=False)
+    test = data.split("test")
+    paraphrases = load_paraphrases()
+    told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
+    runs = []
+    for training in args.trainings:
+        seen = training_words(training)
+        unseen = np.array([bool(words(t.text) - seen) for t in told])
+        for seed in args.seeds:
+            trained = trained_pgae(training, args.profile, seed, device="cpu", progress=False)
+            model, norm = trained.model, trained.normaliser
+            cells, _ = evaluate(model, data, norm)
+            t0 = time.perf_counter()
+            texts = [input_text("repeat language", t.text) for t in told]
+            back = predict(model, test, norm, "repeat language",
+                           language=model.language_encoder.encode_texts(texts))
+            run = {"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),
+                   "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
+                   "readback_%": round(100 * back.correct.mean(), 2),
+                   "unseen_episodes": int(unseen.sum()),
+                   "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2) if unseen.any() else None,
+                   "readback_wrong": [{"told": t.text, "understood": x}
+                                      for t, x, ok in zip(told, back.text, back.correct) if not ok][:40]}
+            table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=not args.no_closed,
+                                        config=get_profile(args.profile).data, progress=False)
+            for loop in ("open", "closed"):
+                if f"{loop}_passed" in table:
+                    passed = table[f"{loop}_passed"].to_numpy()
+                    run[f"{loop}_success_%"] = round(100 * passed.mean(), 2)
+                    if unseen.any():
+                        run[f"{loop}_success_unseen_%"] = round(100 * passed[unseen].mean(), 2)
+            run["measure_seconds"] = round(time.perf_counter() - t0, 1)
+            print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1")}, flush=True)
+            runs.append(run)
+    bench.write({"paraphrases": len(paraphrases), "episodes": len(told), "runs": runs})
+
+
+if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
+    main()

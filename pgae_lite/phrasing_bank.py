@@ -1,0 +1,84 @@
+"""Training PGAE-BERT on instructions said in many ways (not in the paper).
+
+Paper, Sec. 3: PGAE-BERT's pretrained encoder "has the potential to recognise
+unseen natural language", but trained on the dataset's three-word descriptions
+alone it reads a free-form instruction as something far from anything it was
+trained on. With ``TrainConfig.phrasings`` = K > 0, every sample whose signal
+takes a description (execute, repeat both, repeat language) reads, with
+probability :data:`PHRASING_PROB`, one of K sentences that say its
+description in other words (:func:`pgae_lite.phrasings.phrasings`, a grammar
+and lexicon written for the purpose, independent of the held-out test
+sentences) instead of the description itself. The targets stay the dataset's
+words. The encoder stays frozen: the K sentences of each meaning and signal
+are encoded once (``3 x 36 x K`` sentences) and kept on disk like its table of
+fixed inputs, so a training step costs what PGAE-BERT's costs.
+"""
+from __future__ import annotations
+
+import itertools
+
+import torch
+
+from .language import CANONICAL, SIGNALS, SLOTS, VOCABULARY
+from .phrasings import phrasings
+from .pretrained import PretrainedLanguageEncoder, input_text
+from .signals import LANG_IN, SignalBatch
+from .utils import cache_dir, config_digest, load_torch, save_torch
+
+#: Chance that a sample with a description reads a phrasing instead (else the description).
+PHRASING_PROB = 0.5
+MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
+TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, repeat both, repeat language
+
+
+class PhrasingBank:
+    """Sentence vectors of K phrasings per (signal, meaning): a tensor (3, 36, K, D)."""
+
+    def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0):
+        if not isinstance(encoder, PretrainedLanguageEncoder):
+            raise ValueError("phrasings need PGAE-BERT's pretrained language encoder "
+                             "(ModelConfig.language_encoder='pretrained'); this model has "
+                             f"{type(encoder).__name__}")
+        self.per_meaning = per_meaning
+        self.texts = [input_text(SIGNALS[s], text) for s in TEXT_SIGNALS for m in MEANINGS
+                      for text in phrasings(*m, per_meaning, seed=seed)]
+        key = config_digest({"texts": self.texts, "encoder": encoder.transformer.digest,
+                             "pooling": encoder.pooling})
+        path = cache_dir() / "embeddings" / f"phrasings-{key}.pt"
+        if path.exists():
+            vectors = load_torch(path, ("vectors",), what="phrasing cache")["vectors"]
+        else:
+            vectors = encoder._run_transformer(self.texts)          # (3·36·K, D), once
+            save_torch({"vectors": vectors}, path)
+        shape = (len(TEXT_SIGNALS), len(MEANINGS), per_meaning, -1)
+        self.vectors = vectors.reshape(shape).to(encoder.table.device)  # (3, 36, K, D)
+        # input token -> its canonical word's position in its slot (-1: not a description word)
+        self.slot_index = torch.full((len(VOCABULARY),), -1, dtype=torch.long)
+        for slot in SLOTS:
+            for i, word in enumerate(slot):
+                for w in (word, *[s for s, c in CANONICAL.items() if c == word]):
+                    if w in VOCABULARY:
+                        self.slot_index[VOCABULARY.index(w)] = i
+
+    def meanings(self, tokens: torch.Tensor) -> torch.Tensor:
+        """``lang_tokens`` (B, 5) with a description -> meaning index 0..35 (B,)."""
+        a, c, s = (self.slot_index.to(tokens.device)[tokens[:, k].clamp(max=len(VOCABULARY) - 1)]
+                   for k in (1, 2, 3))
+        return (a * len(SLOTS[1]) + c) * len(SLOTS[2]) + s
+
+    def features(self, model: torch.nn.Module, batch: SignalBatch,
+                 generator: torch.Generator) -> torch.Tensor:
+        """The language features of a training batch (B, D): phrasings for some samples."""
+        base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
+        size = len(batch.signal)
+        pick = torch.rand(size, generator=generator) < PHRASING_PROB
+        which = torch.randint(self.per_meaning, (size,), generator=generator)
+        takes = torch.tensor([LANG_IN[s] for s in batch.signal.tolist()]) & pick
+        if not takes.any():
+            return base
+        rows = takes.nonzero().flatten()
+        signal_row = torch.tensor([TEXT_SIGNALS.index(s) for s in batch.signal[rows].tolist()])
+        meaning = self.meanings(batch.lang_tokens[rows].cpu())
+        out = base.clone()
+        out[rows.to(base.device)] = self.vectors[signal_row, meaning, which[rows]]
+        return out

