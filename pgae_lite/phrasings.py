@@ -106,7 +106,7 @@ def phrasing(action: str, colour: str, speed: str, rng: random.Random,
              lexicon: PhraseLexicon | None = None) -> str:
     """One random sentence that tells NICO to do (action, colour, speed).
 
-    ``rng`` is a :class:`random.Random`; ``lexicon`` (a
+    ``rng`` is a ``random.Random``; ``lexicon`` (a
     :class:`~pgae_lite.phrase_lexicon.PhraseLexicon`) defaults to
     :data:`~pgae_lite.phrase_lexicon.LEXICON`.
     """
