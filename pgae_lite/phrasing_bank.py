@@ -54,16 +54,16 @@ class PhrasingBank:
         self.vectors = vectors.reshape(shape).to(encoder.table.device)  # (3, 36, K, D)
         # input token -> its canonical word's position in its slot (-1: not a description word)
         self.slot_index = torch.full((len(VOCABULARY),), -1, dtype=torch.long)
-        for slot in SLOTS:
-            for i, word in enumerate(slot):
-                for w in (word, *[s for s, c in CANONICAL.items() if c == word]):
-                    if w in VOCABULARY:
-                        self.slot_index[VOCABULARY.index(w)] = i
+        for word, canonical in CANONICAL.items():
+            slot = next(slot for slot in SLOTS if canonical in slot)
+            self.slot_index[VOCABULARY.index(word)] = slot.index(canonical)
+        # signal -> its row in the bank (-1: the signal takes no description)
+        self.signal_row = torch.full((len(SIGNALS),), -1, dtype=torch.long)
+        self.signal_row[list(TEXT_SIGNALS)] = torch.arange(len(TEXT_SIGNALS))
 
     def meanings(self, tokens: torch.Tensor) -> torch.Tensor:
         """``lang_tokens`` (B, 5) with a description -> meaning index 0..35 (B,)."""
-        a, c, s = (self.slot_index.to(tokens.device)[tokens[:, k].clamp(max=len(VOCABULARY) - 1)]
-                   for k in (1, 2, 3))
+        a, c, s = self.slot_index[tokens[:, 1:4].cpu()].unbind(1)         # each (B,)
         return (a * len(SLOTS[1]) + c) * len(SLOTS[2]) + s
 
     def features(self, model: torch.nn.Module, batch: SignalBatch,
@@ -71,14 +71,13 @@ class PhrasingBank:
         """The language features of a training batch (B, D): phrasings for some samples."""
         base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
         size = len(batch.signal)
-        pick = torch.rand(size, generator=generator) < PHRASING_PROB
+        row = self.signal_row[batch.signal.cpu()]                            # (B,), -1: no description
+        takes = (row >= 0) & (torch.rand(size, generator=generator) < PHRASING_PROB)
         which = torch.randint(self.per_meaning, (size,), generator=generator)
-        takes = torch.tensor([LANG_IN[s] for s in batch.signal.tolist()]) & pick
         if not takes.any():
             return base
         rows = takes.nonzero().flatten()
-        signal_row = torch.tensor([TEXT_SIGNALS.index(s) for s in batch.signal[rows].tolist()])
-        meaning = self.meanings(batch.lang_tokens[rows].cpu())
         out = base.clone()
-        out[rows.to(base.device)] = self.vectors[signal_row, meaning, which[rows]]
+        meaning = self.meanings(batch.lang_tokens[rows])
+        out[rows.to(base.device)] = self.vectors[row[rows], meaning, which[rows]]
         return out
