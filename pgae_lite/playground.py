@@ -125,6 +125,7 @@ class PlayResult:
     gate: np.ndarray          # (hidden,) GMU gate z: 1 lets the action through, 0 the language
     rollout: Execution | None  # the simulator's execution of ``joints`` (None: not simulated)
     loop: str | None = None   # "open", "closed" or None: how the simulator ran the joints
+    understood: str | None = None  # typed text said back (``repeat language``): what the model took it to mean
 
     def summary(self) -> str:
         """A few lines of plain text: task, episode, words, joint error, the simulator's verdict."""
@@ -136,6 +137,8 @@ class PlayResult:
                  f"{'a description of the action' if expected else '<EOS> alone'})",
                  f"joints: nRMSE {self.nrmse:.2f}% against {TARGETS[self.signal]}; "
                  f"mean gate z {self.gate.mean():.2f} (0 = language, 1 = action)"]
+        if self.understood is not None:
+            lines.insert(1, f"I understood: {self.understood or '<EOS>'} (the typed text said back with repeat language)")
         if self.rollout is not None:
             verdict = "the cube moved as told" if self.rollout.passed else f"failed ({self.rollout.check.reason})"
             held = self.signal in ("describe", "repeat language")
@@ -245,6 +248,11 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     target = normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], batch.joint_target], 1))[0, :length]
     joints, target = joints.cpu().numpy(), target.cpu().numpy()
     generated = decode(out["logits"][0].argmax(-1).cpu())
+    understood = None
+    if reads_words and text:                               # readback: the same words, said back, no action shown
+        back_language = model.language_encoder.encode_texts([input_text("repeat language", said)]) if free else None
+        back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
+        understood = decode(back["logits"][0].argmax(-1).cpu())
     expected = [tuple(VOCABULARY[w] for w in alt) for alt in Pattern.from_number(pattern).descriptions()]
 
     config = config or simulator_config(data)
@@ -258,7 +266,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     nrmse = 100 * float(np.sqrt(np.mean((joints[1:] - target[1:]) ** 2))) / data.joint_range()
     return PlayResult(signal, pattern, sim_variation, str(data.ids[row]), told, generated,
                       is_correct(generated, expected if LANG_OUT[SIGNALS.index(signal)] else None),
-                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop)
+                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood)
 
 
 class Playground:

@@ -23,6 +23,7 @@ from pgae_lite.language import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
 from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_parts
 from pgae_lite.pgae import PGAE
+from pgae_lite.pretrained import input_text
 from pgae_lite.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
 
@@ -105,7 +106,11 @@ def test_typed_description_picks_the_episode_and_keeps_its_synonyms(tiny, toy):
     assert alternative != 0 and not np.allclose(r.joints, canonical.joints)
     # Under describe the words are not read; they only pick the episode.
     d = play(model, None, normaliser, toy, "describe", ARRANGEMENT, 0, "push yellow fast", loop=None)
-    assert d.pattern == 117 and d.told == "describe"
+    assert d.pattern == 117 and d.told == "describe" and d.understood is None
+    # The typed words said back (readback): what repeat language generates from them, shown first.
+    back = predict(model, toy.subset([_row(toy, 117)]), normaliser, "repeat language")
+    assert canonical.understood == back.text[0]
+    assert f"I understood: {canonical.understood or '<EOS>'}" in canonical.summary().splitlines()[1]
 
 
 @pytest.mark.parametrize("signal, text, error, message", [
@@ -179,7 +184,10 @@ def test_pgae_bert_reads_free_text(toy):
     paper = predict(model, toy.subset([row]), normaliser, "execute", language=instruction_features(model, [text]))
     np.testing.assert_allclose(r.joints, paper.joints[0, :len(r.joints)], atol=1e-5)
     plain = play(model, None, normaliser, toy, "execute", 0, 3, loop=None)
-    assert not np.allclose(r.joints, plain.joints)
+    assert not np.allclose(r.joints, plain.joints) and plain.understood is None
+    said = predict(model, toy.subset([row]), normaliser, "repeat language",
+                   language=model.language_encoder.encode_texts([input_text("repeat language", text)]))
+    assert r.understood == said.text[0]
     with pytest.raises(LanguageError, match="'describe' reads no words"):
         play(model, None, normaliser, toy, "describe", 0, 3, text, loop=None)
     # In the widget, with both models to choose from.
