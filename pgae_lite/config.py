@@ -125,6 +125,9 @@ class TrainConfig:
     # Not in the paper: K > 0 = samples with a description read, half of the time, one of K sentences
     # saying it in other words (phrasing_bank.py; PGAE-BERT only). 0 = the dataset's descriptions.
     phrasings: int = 0
+    # "all": the phrasings use the whole lexicon; "held-out": less phrase_lexicon.held_out_words(), so
+    # that a test sentence with one of those words says something never trained on.
+    phrasing_words: str = "all"
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
@@ -139,6 +142,8 @@ class TrainConfig:
         if isinstance(self.phrasings, bool) or not hasattr(self.phrasings, "__index__") or self.phrasings < 0:
             raise ValueError(f"TrainConfig phrasings must be a whole number >= 0 (0: the dataset's "
                              f"descriptions only); got {self.phrasings!r}")
+        if self.phrasing_words not in ("all", "held-out"):
+            raise ValueError(f"TrainConfig phrasing_words must be 'all' or 'held-out'; got {self.phrasing_words!r}")
         for name in ("epochs", "batch_size", "checkpoint_every", "max_train_samples"):
             value = getattr(self, name)
             if name == "max_train_samples" and value is None:
@@ -253,6 +258,9 @@ TRAININGS: dict[str, Training] = {
     "PGAE-views": Training(train={"opposite_prob": 0.5}),
     # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction (free-form language).
     "PGAE-BERT-phrasings": Training(model={"language_encoder": "pretrained"}, train={"phrasings": 60}),
+    # The same with some words never trained on (phrase_lexicon.held_out_words): free_language.py's "unseen" measure.
+    "PGAE-BERT-phrasings-held-out": Training(model={"language_encoder": "pretrained"},
+                                             train={"phrasings": 60, "phrasing_words": "held-out"}),
 }
 #: row -> (training, evaluated on the opposite agent's actions?)
 ROWS: dict[str, tuple[str, bool]] = {

@@ -15,7 +15,7 @@ import re
 from dataclasses import dataclass, fields, replace
 
 from .errors import ArgumentError
-from .language import ACTIONS, COLOURS, SPEEDS, SYNONYMS
+from .language import ACTIONS, COLOURS, SPEEDS, SYNONYMS, VOCABULARY
 from .validate_api import instance_of
 
 SLOTS = ("action", "colour", "speed")
@@ -91,6 +91,25 @@ class PhraseLexicon:
         return replace(self, **{f.name: {k: keep(v) for k, v in value.items()}
                                 if isinstance(value := getattr(self, f.name), dict)
                                 else keep(value) for f in fields(self)})
+
+
+def held_out_words(lexicon: "PhraseLexicon | None" = None) -> tuple[str, ...]:
+    """Words to keep out of training, to measure language never trained on.
+
+    For each meaning of each slot, every third of its one-word phrases that are
+    not the dataset's own words (in the lexicon's order, from the second on):
+    a rule on the lexicon alone, chosen before looking at any test sentence.
+    ``lexicon.without(*held_out_words())`` is the lexicon of the training
+    ``PGAE-BERT-phrasings-held-out``.
+    """
+    lex = lexicon or LEXICON
+    dataset_words = {w for word in VOCABULARY for w in words_of(word)}
+    held: dict[str, None] = {}
+    for slot in SLOTS:
+        for phrases in lex.phrases(slot).values():
+            single = [p for p in phrases if len(words_of(p)) == 1 and p not in dataset_words]
+            held.update(dict.fromkeys(single[1::3]))
+    return tuple(held)
 
 
 def _entries(value) -> list[str]:
@@ -195,4 +214,4 @@ LEXICON = PhraseLexicon(
 )
 
 
-__all__ = ["LEXICON", "MEANINGS", "PhraseLexicon", "SLOTS", "words_of"]
+__all__ = ["LEXICON", "MEANINGS", "PhraseLexicon", "SLOTS", "held_out_words", "words_of"]

@@ -20,6 +20,7 @@ import itertools
 import torch
 
 from .language import CANONICAL, SIGNALS, SLOTS, VOCABULARY
+from .phrase_lexicon import PhraseLexicon
 from .phrasings import phrasings
 from .pretrained import PretrainedLanguageEncoder, input_text
 from .signals import LANG_IN, SignalBatch
@@ -34,14 +35,15 @@ TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, 
 class PhrasingBank:
     """Sentence vectors of K phrasings per (signal, meaning): a tensor (3, 36, K, D)."""
 
-    def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0):
+    def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
+                 lexicon: PhraseLexicon | None = None):
         if not isinstance(encoder, PretrainedLanguageEncoder):
             raise ValueError("phrasings need PGAE-BERT's pretrained language encoder "
                              "(ModelConfig.language_encoder='pretrained'); this model has "
                              f"{type(encoder).__name__}")
         self.per_meaning = per_meaning
         self.texts = [input_text(SIGNALS[s], text) for s in TEXT_SIGNALS for m in MEANINGS
-                      for text in phrasings(*m, per_meaning, seed=seed)]
+                      for text in phrasings(*m, per_meaning, seed=seed, lexicon=lexicon)]
         key = config_digest({"texts": self.texts, "encoder": encoder.transformer.digest,
                              "pooling": encoder.pooling})
         path = cache_dir() / "embeddings" / f"phrasings-{key}.pt"

@@ -72,3 +72,5 @@ def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short
         PhrasingBank(PGAE(ModelConfig(units=8)).language_encoder, 2)
     with pytest.raises(ValueError, match="phrasings must be a whole number"):
         TrainConfig(phrasings=-1)
+    with pytest.raises(ValueError, match="phrasing_words must be 'all' or 'held-out'; got 'some'"):
+        TrainConfig(phrasing_words="some")

@@ -9,9 +9,9 @@ from dataclasses import replace
 import pytest
 
 from pgae_lite.errors import ArgumentError, ArgumentTypeError
-from pgae_lite.language import SYNONYMS
+from pgae_lite.language import SYNONYMS, VOCABULARY
 from pgae_lite.paraphrases import load_paraphrases
-from pgae_lite.phrase_lexicon import LEXICON, MEANINGS, SLOTS, words_of
+from pgae_lite.phrase_lexicon import LEXICON, MEANINGS, SLOTS, held_out_words, words_of
 from pgae_lite.phrasings import gerund, phrasing, phrasings, slot_meanings
 
 ALL_MEANINGS = list(itertools.product(*(MEANINGS[slot] for slot in SLOTS)))
@@ -70,6 +70,17 @@ def test_held_out_words_never_appear():
         found = slot_meanings(text)
         assert (set(found["action"]), found["colour"], found["speed"]) == (
             {"push"}, ["red"], ["slowly"]), text
+
+
+def test_the_held_out_rule_keeps_every_meaning_sayable_and_the_dataset_words():
+    held = held_out_words()
+    assert held == held_out_words() and len(held) == len(set(held)) > 20
+    assert not set(held) & {w for word in VOCABULARY for w in words_of(word)}
+    lexicon = LEXICON.without(*held)
+    assert not set(held) & lexicon.words()
+    for meaning in ALL_MEANINGS:                               # every meaning can still be said
+        for text in phrasings(*meaning, 5, lexicon=lexicon):
+            assert not set(held) & set(words_of(text)), text
 
 
 def test_generated_sentences_are_not_the_held_out_test_sentences():
