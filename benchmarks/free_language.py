@@ -21,11 +21,14 @@ never trained on), and measured three ways:
 
 The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
 model's training language (the descriptions, plus the phrasings' lexicon for the
-variant). With ``--original`` it measures only the canonical Table 1 of each
-training on the authors' data instead (runs resumable under benchmarks/out/),
-into results/free_language-original.json. The full lexicon holds every word of the paraphrases, so that subset
+variant). The full lexicon holds every word of the paraphrases, so that subset
 is measured with ``PGAE-BERT-phrasings-held-out``, trained without the words of
-:func:`pgae_lite.phrase_lexicon.held_out_words` (a rule on the lexicon alone). Writes results/free_language.json.
+:func:`pgae_lite.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
+Writes results/free_language.json.
+
+With ``--original`` it measures only the canonical Table 1 of each training on
+the authors' data (runs resumable under benchmarks/out/), into
+results/free_language-original.json.
 """
 from __future__ import annotations
 
@@ -43,7 +46,7 @@ from pgae_lite.instructions import execute_paraphrases, paraphrase_of
 from pgae_lite.language import SIGNALS, VOCABULARY
 from pgae_lite.original import load_original
 from pgae_lite.paraphrases import load_paraphrases
-from pgae_lite.phrase_lexicon import LEXICON, held_out_words
+from pgae_lite.phrase_lexicon import training_lexicon
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.pretrained import input_text
 from pgae_lite.train import train
@@ -58,8 +61,7 @@ def training_words(training: str) -> set[str]:
     seen = set().union(*(words(s) for s in SIGNALS), *(words(w) for w in VOCABULARY))
     train = TRAININGS[training].train
     if train.get("phrasings"):
-        held = held_out_words() if train.get("phrasing_words") == "held-out" else ()
-        seen |= LEXICON.without(*held).words()
+        seen |= training_lexicon(train.get("phrasing_words", "all")).words()
     return seen
 
 
@@ -94,6 +96,7 @@ def main() -> None:
     test = data.split("test")
     paraphrases = load_paraphrases()
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
+    texts = [input_text("repeat language", t.text) for t in told]   # the readback's inputs
     runs = []
     for training in args.trainings:
         seen = training_words(training)
@@ -103,7 +106,6 @@ def main() -> None:
             model, norm = trained.model, trained.normaliser
             cells, _ = evaluate(model, data, norm)
             t0 = time.perf_counter()
-            texts = [input_text("repeat language", t.text) for t in told]
             back = predict(model, test, norm, "repeat language",
                            language=model.language_encoder.encode_texts(texts))
             run = {"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),

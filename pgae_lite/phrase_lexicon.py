@@ -112,6 +112,12 @@ def held_out_words(lexicon: "PhraseLexicon | None" = None) -> tuple[str, ...]:
     return tuple(held)
 
 
+def training_lexicon(phrasing_words: str = "all") -> "PhraseLexicon":
+    """The lexicon a training's phrasings use (``TrainConfig.phrasing_words``): all of it, or less
+    :func:`held_out_words`."""
+    return LEXICON.without(*held_out_words()) if phrasing_words == "held-out" else LEXICON
+
+
 def _entries(value) -> list[str]:
     if isinstance(value, dict):
         return [t for v in value.values() for t in v]
@@ -214,4 +220,4 @@ LEXICON = PhraseLexicon(
 )
 
 
-__all__ = ["LEXICON", "MEANINGS", "PhraseLexicon", "SLOTS", "held_out_words", "words_of"]
+__all__ = ["LEXICON", "MEANINGS", "PhraseLexicon", "SLOTS", "held_out_words", "training_lexicon", "words_of"]

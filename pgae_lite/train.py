@@ -161,10 +161,9 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
     t0 = time.perf_counter() - elapsed
     bank = None                             # its encoding time counts as training time
     if cfg.phrasings:                       # free-form language (phrasing_bank.py), PGAE-BERT only
-        from .phrase_lexicon import LEXICON, held_out_words
+        from .phrase_lexicon import training_lexicon
         from .phrasing_bank import PhrasingBank
-        held = held_out_words() if cfg.phrasing_words == "held-out" else ()
-        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, LEXICON.without(*held))
+        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words))
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:
