@@ -34,10 +34,12 @@ def install(share: float, weight: float, detach: bool) -> None:
 
     def forward_with_first_frame(self, batch, *args, **kwargs):
         out = forward(self, batch, *args, **kwargs)
+        if not self.training:                                            # evaluation: one pass only
+            return out
         s = batch.signal
         reads_frames = (s == EXECUTE) | (s == REPEAT_ACTION) | (s == REPEAT_BOTH)
         rows = torch.nonzero(reads_frames & (torch.rand(len(s), device=s.device) < share))[:, 0]
-        if self.training and len(rows):
+        if len(rows):
             vision = batch.dec_vision[rows]                                  # (n, T-1, 30)
             inputs = (out["h"][rows], vision[:, :1].expand_as(vision), batch.start_joints[rows])
             steps = dict(steps=batch.joint_mask[rows].sum(1))
