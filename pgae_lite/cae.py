@@ -253,9 +253,24 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
     model = ChannelSeparatedCAE(config).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     rng = np.random.default_rng(config.seed)
-    order, pos, history = rng.permutation(len(images)), 0, []
     t0 = time.perf_counter()
     model.train()
+    # On CUDA, cuDNN may pick convolution kernels that add in a varying order: ask for
+    # deterministic ones, so that a seed gives the same weights there too (no effect on the CPU).
+    with torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True):
+        history = _train_loop(model, optimiser, images, config, rng, progress)
+    model.eval()
+    if out_path is not None:                 # atomic: a crash never leaves half a file
+        save_torch({"model": model.state_dict(), "config": config.to_dict(),
+                    "data": data, "history": history,
+                    "seconds": time.perf_counter() - t0}, out_path)
+    return model, history
+
+
+def _train_loop(model: ChannelSeparatedCAE, optimiser: torch.optim.Optimizer, images: np.ndarray,
+                config: CAEConfig, rng: np.random.Generator, progress: bool) -> list[dict]:
+    """``config.iterations`` steps of Adam on batches drawn without replacement; the history."""
+    order, pos, history = rng.permutation(len(images)), 0, []
     for it in tqdm(range(config.iterations), desc=f"CAE ({config.name})", disable=not progress):
         if pos + config.batch_size > len(order):  # a new shuffle when a pass is done
             order, pos = rng.permutation(len(images)), 0
@@ -267,12 +282,7 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
         optimiser.step()
         r, g, b = per_channel.tolist()
         history.append({"iteration": it + 1, "loss": (r + g + b) / 3, "red": r, "green": g, "blue": b})
-    model.eval()
-    if out_path is not None:                 # atomic: a crash never leaves half a file
-        save_torch({"model": model.state_dict(), "config": config.to_dict(),
-                    "data": data, "history": history,
-                    "seconds": time.perf_counter() - t0}, out_path)
-    return model, history
+    return history
 
 
 def load_cae(path: str | Path, device: torch.device | str | None = None) -> tuple[ChannelSeparatedCAE, dict]:
@@ -298,9 +308,10 @@ def extract_features(model: ChannelSeparatedCAE, images: np.ndarray | torch.Tens
     model.eval()                                         # BatchNorm: running statistics
     encoders = [ae.fused_encoder() for ae in model.channels]
     out = []
-    for i in range(0, len(images), batch):
-        channels = model._split(images[i:i + batch])   # 3 x (b, 1, 120, 160)
-        out.append(torch.cat([enc(x) for enc, x in zip(encoders, channels)], dim=1).float().cpu())  # (b, 30)
+    with torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True):  # as train_cae
+        for i in range(0, len(images), batch):
+            channels = model._split(images[i:i + batch])   # 3 x (b, 1, 120, 160)
+            out.append(torch.cat([enc(x) for enc, x in zip(encoders, channels)], dim=1).float().cpu())  # (b, 30)
     model.train(was_training)
     return torch.cat(out).numpy() if out else np.zeros((0, 3 * model.config.features), np.float32)
 

@@ -126,7 +126,7 @@ def test_checkpoint_round_trip_and_refusals(images, tmp_path):
     assert history2 == history
     for p, q in zip(model.state_dict().values(), again.state_dict().values()):
         assert torch.equal(p, q)
-    loaded, ckpt = load_cae(path, "cpu")
+    loaded, ckpt = load_cae(path, model.device)   # the same device: CPU and CUDA round differently
     np.testing.assert_array_equal(extract_features(loaded, images[:4]), extract_features(model, images[:4]))
     assert ckpt["config"]["name"] == "tiny" and not loaded.training
     with pytest.raises(CheckpointMismatchError, match="different config"):
