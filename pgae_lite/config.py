@@ -34,7 +34,7 @@ PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
 
 
 #: What a checkpoint saved before a ModelConfig setting existed was trained with.
-LEGACY_MODEL_SETTINGS = {"joint_feedback": "predicted", "time_stride": 1, "gmu_norm": False}
+LEGACY_MODEL_SETTINGS = {"joint_feedback": "predicted", "time_stride": 1, "gmu_norm": False, "plan_keyframes": 0}
 
 
 @dataclass
@@ -63,8 +63,15 @@ class ModelConfig:
     # every sample early in training, and describe never learns: one sentence for every action. The
     # measurements are on the book's results page (A2, "The describe collapse").
     gmu_norm: bool = True
+    # Deviation from paper: a plan head reads h and predicts this many keyframes of the motion in training
+    # (plan.PlanHead; 0 = none, the paper's). It makes h carry which cube the words mean in this scene, which
+    # the recorded frames otherwise tell the decoder: without it the closed loop mostly moves the other cube.
+    plan_keyframes: int = 10
 
     def __post_init__(self):
+        if isinstance(self.plan_keyframes, bool) or not isinstance(self.plan_keyframes, int) or self.plan_keyframes < 0:
+            raise ValueError(f"plan_keyframes must be a whole number >= 0 (0 = no plan head, the paper's); "
+                             f"got {self.plan_keyframes!r}")
         if not isinstance(self.time_stride, int) or self.time_stride < 1:
             raise ValueError(f"time_stride must be a whole number >= 1 (1 = every step, the paper's); "
                              f"got {self.time_stride!r}")
@@ -88,6 +95,8 @@ class TrainConfig:
     # rate). Its history (what was tried, what each change did) is on the book's results page (A2).
     epochs: int = 300
     batch_size: int = 16
+    # Deviation from paper: each batch holds samples of one length (train.batch_indices); less time per epoch.
+    length_batches: bool = True
     # Deviation from paper: AdamW 3e-3 with warm-up and cosine decay (paper: Adam 1e-5, constant).
     lr: float = 3e-3
     schedule: str = "cosine"            # "cosine" (warm-up, then cosine to 0) or "constant"
@@ -122,6 +131,9 @@ class TrainConfig:
     language_weight: float = 1.0        # α
     # Deviation from paper: β = 4 (paper: 1). A 0.5% joint error is a loss of about 1e-4, the words' ~0.1.
     action_weight: float = 4.0          # β
+    # Deviation from paper: γ, the weight of the plan head's error (plan.py) inside the action loss (paper: no
+    # plan head). Used when ModelConfig.plan_keyframes > 0.
+    plan_weight: float = 4.0
     # Not in the paper: K > 0 = samples with a description read, half of the time, one of K sentences
     # saying it in other words (phrasing_bank.py; PGAE-BERT only). 0 = the dataset's descriptions.
     phrasings: int = 0
@@ -201,11 +213,11 @@ PROFILES: dict[str, Profile] = {
                                  every=10)),
     "book": Profile("book", ModelConfig()),
     "paper": Profile("paper", ModelConfig(cell="peephole", joint_feedback="predicted", time_stride=1,
-                                    gmu_norm=False), TrainConfig(
-        epochs=6000, batch_size=6, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
+                                    gmu_norm=False, plan_keyframes=0), TrainConfig(
+        epochs=6000, batch_size=6, length_batches=False, lr=1e-5, schedule="constant", warmup=0.0, clip=None,
         signals_per_sample=False, teacher_language=False, input_noise=0.0,
         joint_input_noise=None,
-        weight_decay=0.0, vision_scaling="global", action_weight=1.0,
+        weight_decay=0.0, vision_scaling="global", action_weight=1.0, plan_weight=0.0,
         checkpoint_every=100),
         cae=CAEConfig("paper"), chapters=ChapterSettings(runs_per_action=6)),
 }

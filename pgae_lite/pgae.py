@@ -28,6 +28,7 @@ from .config import ModelConfig
 from .data import JOINT_DIM, VISION_DIM
 from .language import DEFAULT_LEXICON, VOCABULARY, Lexicon
 from .layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
+from .plan import PlanHead
 from .signals import SignalBatch
 
 WORDS = len(VOCABULARY)
@@ -262,6 +263,9 @@ class PGAE(nn.Module):
                                        normalise_action=self.cfg.gmu_norm)
         self.language_decoder = LanguageDecoder(self.cfg, lexicon)
         self.action_decoder = ActionDecoder(self.cfg)
+        # Deviation from paper: a plan head on h, trained to predict keyframes of the motion (plan.py).
+        self.plan_head = (PlanHead(self.cfg.hidden, self.cfg.plan_keyframes, self.cfg.units)
+                          if self.cfg.plan_keyframes else None)
 
     def encode(self, batch: SignalBatch, language: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
         """Shared representation h and GMU gate z, each (B, hidden).
@@ -281,7 +285,8 @@ class PGAE(nn.Module):
 
     def forward(self, batch: SignalBatch, teacher_language: bool = False, feedback: str = "greedy",
                 language: torch.Tensor | None = None) -> dict[str, torch.Tensor]:
-        """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden).
+        """Returns ``logits`` (B, 4, 23), ``joints`` (B, T-1, 5), ``h`` and ``gate`` (B, hidden),
+        and ``plan`` (B, K x 5) when the model has a plan head.
 
         ``teacher_language``: the language decoder reads the target words (training).
         ``language`` (B, D): precomputed language features in place of the encoder's (see :meth:`encode`).
@@ -290,7 +295,10 @@ class PGAE(nn.Module):
         logits = self.language_decoder(
             h, batch.lang_target if teacher_language else None, feedback=feedback)
         joints = self.action_decoder(h, batch.dec_vision, batch.start_joints, steps=batch.joint_mask.sum(1))
-        return {"logits": logits, "joints": joints, "h": h, "gate": z}
+        out = {"logits": logits, "joints": joints, "h": h, "gate": z}
+        if self.plan_head is not None:
+            out["plan"] = self.plan_head(h)                     # keyframes of the motion h plans
+        return out
 
 
 def count_parameters(model: nn.Module) -> int:

@@ -29,7 +29,7 @@ def test_shapes(toy_tensors, cell):
 
 
 def test_parameter_count_is_the_authors():
-    assert count_parameters(PGAE(ModelConfig(cell="peephole", time_stride=1))) == 657_778
+    assert count_parameters(PGAE(ModelConfig(cell="peephole", time_stride=1, plan_keyframes=0))) == 657_778
     assert ModelConfig().state_dim == 400
 
 
@@ -45,10 +45,12 @@ def test_model_config_defaults_are_the_book_recipe():
 def test_fused_parameter_count():
     """nn.LSTM has two bias vectors and no peepholes: 4·H extra − 3·H per layer."""
     per_layer = 100                                                # 4H − 3H
-    assert count_parameters(PGAE(ModelConfig(time_stride=1))) == 657_778 + 4 * 2 * per_layer
+    assert count_parameters(PGAE(ModelConfig(time_stride=1, plan_keyframes=0))) == 657_778 + 4 * 2 * per_layer
     # time_stride 2: the decoder writes 5 more joints per step
     stride2 = 5 * (100 + 1)
-    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer + stride2
+    # the plan head (book recipe): h (50) -> 100 -> 10 keyframes x 5 joints
+    plan = (50 + 1) * 100 + (100 + 1) * 50
+    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer + stride2 + plan
 
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
@@ -95,7 +97,7 @@ def test_language_decoder_modes(toy_tensors, cell):
 def test_gradients_reach_every_module(toy_tensors):
     model = PGAE(ModelConfig(units=16, joint_feedback="predicted"))
     out = model(_batch(toy_tensors), teacher_language=True)
-    (out["logits"].sum() + out["joints"].sum()).backward()
+    (out["logits"].sum() + out["joints"].sum() + out["plan"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
     assert not missing
 

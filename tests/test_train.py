@@ -16,10 +16,15 @@ from pgae_lite.train import CHECKPOINT, DataMismatchError, load_checkpoint, load
 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
-    """12 training samples, batches of 4, a few epochs: a second or two of training."""
+    """12 training samples, batches of 4, a few epochs: a second or two of training.
+
+    No plan head (plan.py): with 12 samples each is its own pattern, and a few hundred steps are
+    spent on the words; tests/test_plan.py trains the head.
+    """
     cfg = replace(TrainConfig(), epochs=4, batch_size=4, lr=3e-3, max_train_samples=12, checkpoint_every=1,
                   action_weight=1.0, input_noise=0.05, joint_input_noise=None)
-    return Profile("tiny", ModelConfig(units=units, joint_feedback="predicted"), replace(cfg, **train))
+    return Profile("tiny", ModelConfig(units=units, joint_feedback="predicted", plan_keyframes=0),
+                   replace(cfg, **train))
 
 
 def _weights(model):
@@ -37,10 +42,11 @@ def test_learns_a_handful_of_samples(toy_short):
     (Generating their descriptions 100% right takes thousands of optimiser steps with the current
     recipe, far more than a unit test may spend, so description accuracy is not asserted here.)
     """
-    prof = tiny_profile(units=32, epochs=40, lr=1e-2)
+    # (60 epochs: at 40, <EOS> was learnt on some seeds and not on others, with or without length batches)
+    prof = tiny_profile(units=32, epochs=60, lr=1e-2)
     trained = train(toy_short, prof, progress=False, device="cpu")
     h = trained.history
-    assert len(h) == 40 and [r["epoch"] for r in h] == list(range(1, 41))
+    assert len(h) == 60 and [r["epoch"] for r in h] == list(range(1, 61))
     first = h[0]
     # Each epoch draws new signals for its 12 samples, so single epochs are noisy: average the last 5.
     assert np.mean([r["loss"] for r in h[-5:]]) < 0.7 * first["loss"]
