@@ -10,7 +10,9 @@ paper's execute (the decoder reads the recorded vision), and closed loop (it
 reads what its own motion shows). Prints the success rate per action and
 speed and the time per episode; writes the success rates, their gap and every
 failed closed-loop episode to results/closed_loop.json, with the model's Table 1
-cells on the same data (:func:`pgae_lite.evaluate.evaluate`). ``--limit N`` takes N
+cells on the same data (:func:`pgae_lite.evaluate.evaluate`) and whether its h says
+which cube to move (:func:`pgae_lite.plan.which_cube_probe`; ``PGAE-no-plan`` is the
+recipe without the plan head). ``--limit N`` takes N
 episodes evenly spread over the 216 of the test split. The models are small:
 one thread is as fast as two.
 """
@@ -23,6 +25,7 @@ from pgae_lite.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.plan import which_cube_probe
 
 
 def main() -> None:
@@ -54,6 +57,7 @@ def main() -> None:
                          "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
                          "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
                          "seconds_per_episode": round(seconds / len(table), 3),
+                         "which_cube_probe_%": round(which_cube_probe(trained.model, data, trained.normaliser), 2),
                          "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
                          "summary": summary.reset_index().round(2).to_dict(orient="records"),
                          "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]

@@ -266,6 +266,8 @@ class Training:
 TRAININGS: dict[str, Training] = {
     "PGAE": Training(),
     "PGAE-BERT": Training(model={"language_encoder": "pretrained"}),
+    # Not a Table 1 row: the recipe without the plan head (plan.py), to show what the head changes (chapter 07).
+    "PGAE-no-plan": Training(model={"plan_keyframes": 0}),
     # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
     "PGAE-views": Training(train={"opposite_prob": 0.5}),
     # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction (free-form language).

@@ -31,8 +31,9 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from .data import JOINT_DIM
-from .signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH
+from .data import JOINT_DIM, Normaliser, PGAEDataset
+from .patterns import Pattern
+from .signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH, make_batch, signal_ids
 
 #: The signals whose action target is the whole motion: their h must carry the plan.
 PLAN_SIGNALS = (EXECUTE, REPEAT_ACTION, REPEAT_BOTH)
@@ -78,3 +79,50 @@ def plan_loss(plan: torch.Tensor, target: torch.Tensor, signal: torch.Tensor) ->
     if not rows.any():
         return plan.new_zeros(())
     return ((plan[rows] - target[rows]) ** 2).mean()
+
+
+@torch.no_grad()
+def execute_representations(model: nn.Module, data: PGAEDataset, normaliser: Normaliser) -> torch.Tensor:
+    """h of every sample of ``data`` under ``execute`` (its description i mod 8, first step), (N, hidden)."""
+    model.eval()
+    device = next(model.parameters()).device
+    tensors = normaliser.tensors(data, device)
+    index = torch.arange(len(data))
+    batch = make_batch(tensors, index, signal_ids("execute", len(data)), index % 8)
+    return model.encode(batch)[0].cpu()
+
+
+def probe_accuracy(x: torch.Tensor, y: torch.Tensor, x_test: torch.Tensor, y_test: torch.Tensor,
+                   steps: int = 200) -> float:
+    """Test accuracy (%) of logistic regression fitted on (x (N, D), y (N,) of 0/1), on (x_test, y_test)."""
+    mean, std = x.mean(0), x.std(0) + 1e-6
+    probe = nn.Linear(x.shape[1], 1)
+    optimiser = torch.optim.LBFGS(probe.parameters(), max_iter=steps, line_search_fn="strong_wolfe")
+
+    def closure():
+        optimiser.zero_grad()
+        loss = nn.functional.binary_cross_entropy_with_logits(probe((x - mean) / std)[:, 0], y.float())
+        loss = loss + 1e-3 * probe.weight.pow(2).sum()                     # a little L2: separable data
+        loss.backward()
+        return loss
+
+    with torch.enable_grad():
+        optimiser.step(closure)
+    with torch.no_grad():
+        said = probe((x_test - mean) / std)[:, 0] > 0
+    return 100 * float((said == y_test.bool()).float().mean())
+
+
+def which_cube_probe(model: nn.Module, data: PGAEDataset, normaliser: Normaliser) -> float:
+    """Does h say which cube to move? A linear probe's test accuracy (%), left cube or right.
+
+    The probe (:func:`probe_accuracy`), on h under ``execute`` (:func:`execute_representations`),
+    is fitted on the training split and scored on the test split, whose scenes pair colours
+    and actions as no training sample did. 50% is chance.
+    """
+    def side(split: PGAEDataset) -> torch.Tensor:                        # 1 = the left cube
+        return torch.tensor([int(Pattern.from_number(int(p)).side == "L") for p in split.pattern])
+
+    train, test = data.split("train"), data.split("test")
+    return probe_accuracy(execute_representations(model, train, normaliser), side(train),
+                          execute_representations(model, test, normaliser), side(test))

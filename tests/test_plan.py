@@ -71,3 +71,23 @@ def test_head_learns_the_plan(toy_short):
         before = plan_loss(fresh(batch)["plan"], target, batch.signal)
         after = plan_loss(trained.model(batch)["plan"], target, batch.signal)
     assert after < 0.5 * before
+
+
+def test_probe_reads_what_is_linearly_there_and_not_what_is_not():
+    from pgae_lite.plan import probe_accuracy
+
+    g = torch.Generator().manual_seed(0)
+    x, x_test = torch.randn(1000, 50, generator=g), torch.randn(200, 50, generator=g)
+    y, y_test = (x[:, 3] > 0).long(), (x_test[:, 3] > 0).long()      # one dimension says it
+    assert probe_accuracy(x, y, x_test, y_test) >= 95.0
+    noise = torch.randint(2, (200,), generator=g)                    # labels h cannot know
+    assert 30.0 < probe_accuracy(x, torch.randint(2, (1000,), generator=g), x_test, noise) < 70.0
+
+
+def test_which_cube_probe_runs_on_a_model(toy_short):
+    from pgae_lite.data import Normaliser
+    from pgae_lite.plan import which_cube_probe
+
+    normaliser = Normaliser.fit(toy_short.split("train"))
+    accuracy = which_cube_probe(PGAE(ModelConfig(units=16)), toy_short, normaliser)
+    assert 0.0 <= accuracy <= 100.0
