@@ -18,6 +18,7 @@ one thread is as fast as two.
 """
 from __future__ import annotations
 
+import statistics
 import time
 
 from harness import Benchmark
@@ -62,7 +63,24 @@ def main() -> None:
                          "summary": summary.reset_index().round(2).to_dict(orient="records"),
                          "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
                          .to_dict(orient="records")})
-    bench.write({"limit": args.limit, "tracking": not args.no_tracking, "runs": runs})
+    trainings = {}
+    for training in args.trainings:            # over seeds: what the book quotes
+        mine = [r for r in runs if r["training"] == training]
+        trainings[training] = {
+            "seeds": [r["seed"] for r in mine],
+            "closed_median_%": statistics.median(r["closed_success_%"] for r in mine),
+            "closed_min_%": min(r["closed_success_%"] for r in mine),
+            "open_median_%": statistics.median(r["open_success_%"] for r in mine),
+            "gap_max_points": max(r["gap_points"] for r in mine),
+            "which_cube_probe_median_%": statistics.median(r["which_cube_probe_%"] for r in mine),
+            # of the failed closed-loop episodes, those in which the other cube moved (the wrong cube)
+            "other_cube_%_of_failures": round(100 * sum("the other cube moved" in f["closed_reason"]
+                                                        for r in mine for f in r["closed_failures"])
+                                              / max(1, sum(len(r["closed_failures"]) for r in mine)), 2),
+            "describe_median_%": statistics.median(r["table1"]["describe"]["accuracy"] for r in mine)}
+        print(f"{training}: closed loop median {trainings[training]['closed_median_%']:.2f}%, "
+              f"worst seed {trainings[training]['closed_min_%']:.2f}%")
+    bench.write({"limit": args.limit, "tracking": not args.no_tracking, "trainings": trainings, "runs": runs})
 
 
 if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
