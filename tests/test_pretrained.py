@@ -174,7 +174,7 @@ def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
                        torch.tensor([0, 1, 2, 3]))
     out = model(batch, teacher_language=True)
     assert out["logits"].shape == (4, 4, 23) and out["joints"].shape == (4, 99, 5)
-    (out["logits"].sum() + out["joints"].sum()).backward()
+    (out["logits"].sum() + out["joints"].sum() + out["plan"].sum()).backward()
     missing = [n for n, p in model.named_parameters() if p.grad is None or p.grad.abs().sum() == 0]
     assert not missing
     assert all(p.grad is None for p in model.language_encoder.transformer.model.parameters())
