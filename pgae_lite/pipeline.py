@@ -10,11 +10,15 @@ earlier chapter (or ``python -m pgae_lite simulate``) already made:
 3. :func:`simulated_dataset` encodes every frame of both views into 30
    features and returns a :class:`~pgae_lite.data.PGAEDataset`;
 4. :func:`trained_pgae` trains one of Table 1's models on it (PGAE, PGAE-BERT,
-   or the model of PGAE-self / PGAE-opposite), cached the same way.
+   or the model of PGAE-self / PGAE-opposite), cached the same way;
+   :func:`trained_pgaes` trains several side by side, one per CPU core.
 """
 from __future__ import annotations
 
+import os
 import warnings
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
@@ -93,6 +97,11 @@ def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
     return dataset
 
 
+def _model_folder(prof, training: str) -> Path:
+    """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests."""
+    return cache_dir() / "pgae" / f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
+
+
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
     """A model of one training (for a row of Table 1) on the profile's simulated data, cached.
@@ -112,8 +121,7 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     name = profile_name(profile)
     dataset = simulated_dataset(name, device, progress)
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
-    stem = _stem(prof.data, prof.cae)
-    folder = cache_dir() / "pgae" / f"{stem}-{training}-{config_digest(prof.to_dict())}"
+    folder = _model_folder(prof, training)
     if (folder / CHECKPOINT).exists():
         try:
             load_checkpoint(folder / CHECKPOINT)
@@ -124,5 +132,58 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     return train(dataset, prof, out_dir=folder, device=device, progress=progress)
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "cae_path", "cached_cae",
+def _train_alone(training: str, profile: str, seed: int) -> float:
+    """A worker of :func:`trained_pgaes`: one training on one thread; its training time (s)."""
+    import torch
+
+    torch.set_num_threads(1)
+    return trained_pgae(training, profile, seed, device="cpu", progress=False).seconds
+
+
+def trained_pgaes(trainings: list[str], profile: str | None = None, seed: int = 0, device: str | None = None,
+                  progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
+    """Several of :func:`trained_pgae`'s models, by training name; those not cached are trained side by side.
+
+    On a CPU the missing models train at the same time, each in its own process on
+    one thread, ``workers`` at once (default: one per core). These networks are
+    small: on the book's 2-core machine one training on both cores ran no faster
+    than on one (A2, "Where the time goes"), so two trainings side by side take
+    about the time of one. With a GPU, or one model to train, they train one after
+    another in this process, as :func:`trained_pgae` does. Workers are spawned, so a
+    script that calls this needs the usual ``if __name__ == "__main__":`` guard.
+    """
+    import torch
+
+    for training in trainings:
+        if training not in TRAININGS:
+            raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
+    name = profile_name(profile)
+    simulated_dataset(name, device, progress)             # recorded and encoded once, before the workers read it
+    cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
+    todo = [t for t in dict.fromkeys(trainings) if not _finished(t, name, seed)]
+    workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
+    if cpu and workers > 1:
+        if progress:
+            print(f"training {', '.join(todo)} side by side, {workers} at a time, one core each ...", flush=True)
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            for training, seconds in zip(todo, pool.map(_train_alone, todo, [name] * len(todo),
+                                                        [seed] * len(todo))):
+                if progress:
+                    print(f"{training}: trained in {seconds / 60:.1f} min", flush=True)
+    return {t: trained_pgae(t, name, seed, device, progress) for t in trainings}
+
+
+def _finished(training: str, profile: str, seed: int) -> bool:
+    """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
+    from .train import CHECKPOINT, load_checkpoint
+
+    prof = training_profile(get_profile(profile, seed=seed), training)
+    folder = _model_folder(prof, training)
+    try:
+        return load_checkpoint(folder / CHECKPOINT)["epoch"] >= prof.train.epochs
+    except Exception:  # noqa: BLE001 -- missing or damaged: trained_pgae trains (again)
+        return False
+
+
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "cae_path", "cached_cae",
            "cached_dataset"]

@@ -33,3 +33,29 @@ def test_chapters_train_the_profiles_recipe_unless_told_otherwise(toy_short, mon
     assert explicit.profile.train.epochs == 1 and len(explicit.history) == 1
     again = pipeline.trained_pgae("PGAE", "smoke", progress=False, **small)   # cached: the same model
     assert again.history == chapter.history
+
+
+def test_several_models_train_side_by_side_and_then_load():
+    """smoke profile: two trainings in two worker processes, then both load from the cache unchanged.
+
+    (Seed 7, which no other test or chapter trains: the two models are not in the cache yet.)
+    """
+    import shutil
+
+    import torch
+
+    from pgae_lite.config import training_profile
+    from pgae_lite.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
+
+    for training in ("PGAE", "PGAE-no-plan"):     # left by an earlier run of this test in the same cache
+        shutil.rmtree(_model_folder(training_profile(get_profile("smoke", seed=7), training), training),
+                      ignore_errors=True)
+        assert not _finished(training, "smoke", 7)
+    models = trained_pgaes(["PGAE", "PGAE-no-plan"], "smoke", seed=7, device="cpu", progress=False, workers=2)
+    assert set(models) == {"PGAE", "PGAE-no-plan"}
+    assert models["PGAE"].model.plan_head is not None and models["PGAE-no-plan"].model.plan_head is None
+    again = trained_pgae("PGAE", "smoke", 7, device="cpu", progress=False)      # from the cache
+    for a, b in zip(again.model.state_dict().values(), models["PGAE"].model.state_dict().values()):
+        assert torch.equal(a, b)
+    with pytest.raises(ValueError, match="unknown training 'PGAE-nope'"):
+        trained_pgaes(["PGAE", "PGAE-nope"], "smoke")
