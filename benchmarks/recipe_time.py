@@ -22,9 +22,11 @@ from pgae_lite.evaluate import evaluate
 from pgae_lite.original import load_original
 from pgae_lite.train import train
 
-#: The recipe before: what it changes in today's book recipe (its training, and its model's time stride).
-PREVIOUS = {"epochs": 1200, "batch_size": 64, "lr": 2e-3, "action_weight": 2.0}
-PREVIOUS_MODEL = {"time_stride": 1}
+#: The recipe before (1,200 epochs, at f994b81): what it changes in today's book recipe, its training and model
+#: (batches of any length, one LSTM step per time step, the paper's GMU, no plan head).
+PREVIOUS = {"epochs": 1200, "batch_size": 64, "lr": 2e-3, "action_weight": 2.0, "length_batches": False,
+            "plan_weight": 0.0}
+PREVIOUS_MODEL = {"time_stride": 1, "gmu_norm": False, "plan_keyframes": 0}
 
 bench = Benchmark("recipe_time", __doc__)
 bench.parser.add_argument("--data", default="../shared/pgae-original-data")
