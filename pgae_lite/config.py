@@ -34,8 +34,7 @@ PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
 
 
 #: What a checkpoint saved before a ModelConfig setting existed was trained with.
-LEGACY_MODEL_SETTINGS = {"joint_feedback": "predicted", "time_stride": 1, "gmu_norm": False, "plan_keyframes": 0,
-                         "language_adapter": 0}
+LEGACY_MODEL_SETTINGS = {"joint_feedback": "predicted", "time_stride": 1, "gmu_norm": False, "plan_keyframes": 0}
 
 
 @dataclass
@@ -59,9 +58,6 @@ class ModelConfig:
     # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py).
     language_encoder: str = "lstm"
     pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
-    # Not in the paper: hidden units of a trained residual MLP on the frozen sentence vector (adapter.py),
-    # for free-form language; 0 = none (the paper's PGAE-BERT). Only with language_encoder="pretrained".
-    language_adapter: int = 0
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
     # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
     # every sample early in training, and describe never learns: one sentence for every action. The
@@ -76,13 +72,6 @@ class ModelConfig:
         if isinstance(self.plan_keyframes, bool) or not isinstance(self.plan_keyframes, int) or self.plan_keyframes < 0:
             raise ValueError(f"plan_keyframes must be a whole number >= 0 (0 = no plan head, the paper's); "
                              f"got {self.plan_keyframes!r}")
-        if isinstance(self.language_adapter, bool) or not isinstance(self.language_adapter, int) \
-                or self.language_adapter < 0:
-            raise ValueError(f"language_adapter must be a whole number >= 0 (hidden units; 0 = none); "
-                             f"got {self.language_adapter!r}")
-        if self.language_adapter and self.language_encoder != "pretrained":
-            raise ValueError("language_adapter works on a pretrained encoder's sentence vector: set "
-                             "language_encoder='pretrained', or language_adapter=0")
         if not isinstance(self.time_stride, int) or self.time_stride < 1:
             raise ValueError(f"time_stride must be a whole number >= 1 (1 = every step, the paper's); "
                              f"got {self.time_stride!r}")
@@ -283,9 +272,6 @@ TRAININGS: dict[str, Training] = {
     "PGAE-views": Training(train={"opposite_prob": 0.5}),
     # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction (free-form language).
     "PGAE-BERT-phrasings": Training(model={"language_encoder": "pretrained"}, train={"phrasings": 60}),
-    # The same with a language adapter on the frozen sentence vector (adapter.py).
-    "PGAE-BERT-adapter": Training(model={"language_encoder": "pretrained", "language_adapter": 384},
-                                  train={"phrasings": 60}),
     # The same with some words never trained on (phrase_lexicon.held_out_words): free_language.py's "unseen" measure.
     "PGAE-BERT-phrasings-held-out": Training(model={"language_encoder": "pretrained"},
                                              train={"phrasings": 60, "phrasing_words": "held-out"}),

@@ -28,7 +28,6 @@ from .config import ModelConfig
 from .data import JOINT_DIM, VISION_DIM
 from .language import DEFAULT_LEXICON, VOCABULARY, Lexicon
 from .layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
-from .adapter import LanguageAdapter
 from .plan import PlanHead
 from .signals import SignalBatch
 
@@ -259,9 +258,6 @@ class PGAE(nn.Module):
         self.lexicon = lexicon
         # LSTM (PGAE) or frozen transformer (PGAE-BERT)
         self.language_encoder = make_language_encoder(self.cfg, lexicon)
-        # Not in the paper: a trained adapter on the frozen sentence vector (adapter.py), for free-form language.
-        self.language_adapter = (LanguageAdapter(self.language_encoder.output_dim, self.cfg.language_adapter)
-                                 if self.cfg.language_adapter else None)
         self.action_encoder = ActionEncoder(self.cfg)
         self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden,
                                        normalise_action=self.cfg.gmu_norm)
@@ -284,8 +280,6 @@ class PGAE(nn.Module):
             if f_lang.shape != (len(batch.signal), self.language_encoder.output_dim):
                 raise ValueError(f"language features must be (batch, {self.language_encoder.output_dim}) = "
                                  f"{(len(batch.signal), self.language_encoder.output_dim)}; got {tuple(f_lang.shape)}")
-        if self.language_adapter is not None:
-            f_lang = self.language_adapter(f_lang)              # f' = f + MLP(f)
         f_act = self.action_encoder(batch.action_input, batch.action_lengths)
         return self.gmu(f_act, f_lang)
 

@@ -68,7 +68,7 @@ def test_recipes_live_here():
     from pgae_lite.config import ROWS, TRAININGS, training_profile
 
     assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-no-plan", "PGAE-views", "PGAE-BERT-phrasings",
-                              "PGAE-BERT-adapter", "PGAE-BERT-phrasings-held-out"]
+                              "PGAE-BERT-phrasings-held-out"]
     assert training_profile(get_profile("book"), "PGAE-no-plan").model.plan_keyframes == 0
     assert {training for training, _ in ROWS.values()} <= set(TRAININGS)
     assert pgae_lite.reproduce.TRAININGS is TRAININGS and pgae_lite.reproduce.ROWS is ROWS
