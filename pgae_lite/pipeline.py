@@ -16,6 +16,7 @@ earlier chapter (or ``python -m pgae_lite simulate``) already made:
 from __future__ import annotations
 
 import os
+import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 from multiprocessing import get_context
@@ -28,10 +29,12 @@ from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, tra
 from .config import TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
 from .simdata import DatasetConfig, generate, to_dataset, training_frames
-from .utils import CorruptCheckpointError, cache_dir, config_digest
+from .utils import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest
 
 if TYPE_CHECKING:
     from .train import Trained
+
+BUSY_POLL_SECONDS = 5      # how often trained_pgae looks whether another process's training has ended
 
 
 def _stem(data: DatasetConfig, cae: CAEConfig) -> str:
@@ -112,7 +115,9 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
     ``train_overrides`` change the profile's training options (e.g. ``seed=1``); without
     them it is the profile's recipe, the model every chapter and ``reproduce`` train.
-    An interrupted training resumes from its last checkpoint.
+    An interrupted training resumes from its last checkpoint. When another process
+    is training the same model into the cache (two chapters run side by side), this
+    waits for it and then loads its model.
     """
     from .train import CHECKPOINT, load_checkpoint, train
 
@@ -129,7 +134,15 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
             warnings.warn(f"cached model not used, training it again: {e}",
                           stacklevel=2)
             (folder / CHECKPOINT).unlink()
-    return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+    announced = False
+    while True:
+        try:
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+        except FolderBusyError:           # another process trains this very model into the cache:
+            if progress and not announced:  # wait for it, then load what it trained
+                print(f"{training}: another process is training this model; waiting for it ...", flush=True)
+            announced = True
+            time.sleep(BUSY_POLL_SECONDS)
 
 
 def _train_alone(training: str, profile: str, seed: int) -> float:

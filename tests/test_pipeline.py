@@ -59,3 +59,25 @@ def test_several_models_train_side_by_side_and_then_load():
         assert torch.equal(a, b)
     with pytest.raises(ValueError, match="unknown training 'PGAE-nope'"):
         trained_pgaes(["PGAE", "PGAE-nope"], "smoke")
+
+
+def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
+    """Two chapters side by side ask for one model: the second waits for the first's training, then loads it."""
+    import shutil
+    import subprocess
+    import sys
+
+    from pgae_lite import pipeline
+    from pgae_lite.config import training_profile
+
+    folder = pipeline._model_folder(training_profile(get_profile("smoke", seed=7), "PGAE"), "PGAE")
+    shutil.rmtree(folder, ignore_errors=True)        # not trained yet (a trained one loads without waiting)
+    pipeline.simulated_dataset("smoke", "cpu", progress=False)     # recorded before the other run starts
+    monkeypatch.setattr(pipeline, "BUSY_POLL_SECONDS", 0.1)
+    holds = ("import sys, time; from pgae_lite.utils import folder_lock\n"
+             "with folder_lock(sys.argv[1]):\n    print('held', flush=True); time.sleep(3)")
+    other = subprocess.Popen([sys.executable, "-c", holds, str(folder)], stdout=subprocess.PIPE, text=True)
+    assert other.stdout.readline().strip() == "held"        # the other process is "training" now
+    trained = pipeline.trained_pgae("PGAE", "smoke", 7, device="cpu", progress=True)
+    assert other.wait(10) == 0 and trained.model.plan_head is not None
+    assert "another process is training this model; waiting" in capsys.readouterr().out
