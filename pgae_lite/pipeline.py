@@ -171,11 +171,11 @@ def trained_pgaes(trainings: list[str], profile: str | None = None, seed: int = 
         if training not in TRAININGS:
             raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
     name = profile_name(profile)
-    simulated_dataset(name, device, progress)             # recorded and encoded once, before the workers read it
     cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
     todo = [t for t in dict.fromkeys(trainings) if not _finished(t, name, seed)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
+        simulated_dataset(name, device, progress)         # recorded and encoded once, before the workers read it
         if progress:
             print(f"training {', '.join(todo)} side by side, {workers} at a time, one core each ...", flush=True)
         with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:

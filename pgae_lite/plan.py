@@ -7,9 +7,8 @@ cube the instruction means in this scene: the binding of the instruction's
 colour ("red") to a side of the table (red lies on the left) can be read off
 the pictures a few steps into the motion. Measured on our data, a linear probe
 reads the side from h of a model trained the paper's way little better than a
-coin, and in closed
-loop, where the pictures are the robot's own, most failures move the other
-cube (chapter 07; the book's results page).
+coin, and in closed loop, where the pictures are the robot's own, most failures
+move the other cube (chapter 07; the book's results page).
 
 The plan head makes h carry the plan. A small network reads h and predicts K
 keyframes of the motion, and its error joins the loss::
