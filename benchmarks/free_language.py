@@ -29,10 +29,17 @@ Writes results/free_language.json.
 With ``--original`` it measures only the canonical Table 1 of each training on
 the authors' data (runs resumable under benchmarks/out/), into
 results/free_language-original.json.
+
+With ``--time`` it measures what the variant costs: ``PGAE-BERT`` and
+``PGAE-BERT-phrasings`` trained from scratch, one after the other in this
+process (same data, seed and load), each with an empty cache so that each pays
+its own sentence encoding; into results/free_language-time.json.
 """
 from __future__ import annotations
 
+import os
 import re
+import tempfile
 import time
 from pathlib import Path
 
@@ -48,8 +55,9 @@ from pgae_lite.original import load_original
 from pgae_lite.paraphrases import load_paraphrases
 from pgae_lite.phrase_lexicon import training_lexicon
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.pretrained import input_text
+from pgae_lite.pretrained import input_text, load_transformer
 from pgae_lite.train import train
+from pgae_lite.utils import CACHE_ENV
 
 
 def words(text: str) -> set[str]:
@@ -82,15 +90,39 @@ def original_table1(bench: Benchmark, args) -> None:
     bench.write({"data": "authors'", "runs": runs})
 
 
+def training_time(bench: Benchmark, args) -> None:
+    """Training wall time of the variant against PGAE-BERT's, side by side in this one process."""
+    bench.name = "free_language-time"
+    data = simulated_dataset(args.profile, "cpu", progress=False)
+    load_transformer()                            # loaded once for both, outside the timings
+    runs = []
+    for seed in args.seeds:
+        for training in ("PGAE-BERT", "PGAE-BERT-phrasings"):
+            profile = training_profile(get_profile(args.profile, seed=seed), training)
+            with tempfile.TemporaryDirectory() as empty:
+                os.environ[CACHE_ENV] = empty     # nothing cached: the encoding is timed too
+                t0 = time.perf_counter()
+                trained = train(data, profile, progress=False)
+                seconds = time.perf_counter() - t0
+            runs.append({"training": training, "seed": seed, "seconds": round(seconds, 1),
+                         "epochs": profile.train.epochs})
+            print(runs[-1], flush=True)
+    total = {t: sum(r["seconds"] for r in runs if r["training"] == t) for t in ("PGAE-BERT", "PGAE-BERT-phrasings")}
+    bench.write({"runs": runs, "ratio": round(total["PGAE-BERT-phrasings"] / total["PGAE-BERT"], 2)})
+
+
 def main() -> None:
     bench = Benchmark("free_language", __doc__, seeds=[0])
     bench.parser.add_argument("--trainings", nargs="+", default=["PGAE-BERT", "PGAE-BERT-phrasings",
                                                                   "PGAE-BERT-phrasings-held-out"])
     bench.parser.add_argument("--no-closed", action="store_true", help="open loop only (fast)")
     bench.parser.add_argument("--original", default=None, help="the authors' data: canonical Table 1 only")
+    bench.parser.add_argument("--time", action="store_true", help="the variant's training time against PGAE-BERT's")
     args = bench.parse()
     if args.original:
         return original_table1(bench, args)
+    if args.time:
+        return training_time(bench, args)
     data = simulated_dataset(args.profile, "cpu", progress=False)
     cae, _ = trained_cae(args.profile, "cpu", progress=False)
     test = data.split("test")

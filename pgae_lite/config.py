@@ -55,7 +55,8 @@ class ModelConfig:
     # step, the decoder reads every 2nd frame and writes the next 2 poses, every pose (paper: 1). Half the
     # LSTM steps per sample.
     time_stride: int = 2
-    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py).
+    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py);
+    # "pretrained-attention" = the same transformer with a trained attention pooling (attention_pooling.py).
     language_encoder: str = "lstm"
     pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
@@ -134,8 +135,9 @@ class TrainConfig:
     # Deviation from paper: γ, the weight of the plan head's error (plan.py) inside the action loss (paper: no
     # plan head). Used when ModelConfig.plan_keyframes > 0.
     plan_weight: float = 4.0
-    # Not in the paper: K > 0 = samples with a description read, half of the time, one of K sentences
-    # saying it in other words (phrasing_bank.py; PGAE-BERT only). 0 = the dataset's descriptions.
+    # Not in the paper: K > 0 = samples with a description read, three times in four
+    # (phrasing_bank.PHRASING_PROB), one of K sentences saying it in other words (phrasing_bank.py;
+    # PGAE-BERT only). 0 = the dataset's descriptions.
     phrasings: int = 0
     # "all": the phrasings use the whole lexicon; "held-out": less phrase_lexicon.held_out_words(), so
     # that a test sentence with one of those words says something never trained on.
@@ -270,10 +272,11 @@ TRAININGS: dict[str, Training] = {
     "PGAE-no-plan": Training(model={"plan_keyframes": 0}),
     # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
     "PGAE-views": Training(train={"opposite_prob": 0.5}),
-    # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction (free-form language).
-    "PGAE-BERT-phrasings": Training(model={"language_encoder": "pretrained"}, train={"phrasings": 60}),
+    # Not a Table 1 row: PGAE-BERT trained on 60 phrasings of every instruction, with an attention pooling
+    # over the frozen transformer's tokens (attention_pooling.py) in place of the mean (free-form language).
+    "PGAE-BERT-phrasings": Training(model={"language_encoder": "pretrained-attention"}, train={"phrasings": 60}),
     # The same with some words never trained on (phrase_lexicon.held_out_words): free_language.py's "unseen" measure.
-    "PGAE-BERT-phrasings-held-out": Training(model={"language_encoder": "pretrained"},
+    "PGAE-BERT-phrasings-held-out": Training(model={"language_encoder": "pretrained-attention"},
                                              train={"phrasings": 60, "phrasing_words": "held-out"}),
 }
 #: row -> (training, evaluated on the opposite agent's actions?)

@@ -75,7 +75,7 @@ class LanguageEncoder(nn.Module):
         return state_to_vector(state)                           # (B, 400)
 
 
-LANGUAGE_ENCODERS = ("lstm", "pretrained")
+LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
 
 
 def make_language_encoder(cfg: ModelConfig,
@@ -83,12 +83,15 @@ def make_language_encoder(cfg: ModelConfig,
     """The language encoder ``cfg.language_encoder`` names; it has an ``output_dim``."""
     if cfg.language_encoder == "lstm":
         return LanguageEncoder(cfg, lexicon)
-    if cfg.language_encoder == "pretrained":
+    if cfg.language_encoder in ("pretrained", "pretrained-attention"):
         if lexicon != DEFAULT_LEXICON:
             raise ValueError("the pretrained language encoder (PGAE-BERT) reads the "
                              "paper's 23 words only; use language_encoder='lstm' with "
                              "a larger lexicon")
         # Imported here: transformers loads only when PGAE-BERT is used.
+        if cfg.language_encoder == "pretrained-attention":   # not in the paper: attention_pooling.py
+            from .attention_pooling import AttentivePretrainedEncoder
+            return AttentivePretrainedEncoder(cfg.pretrained_model)
         from .pretrained import PretrainedLanguageEncoder
         return PretrainedLanguageEncoder(cfg.pretrained_model)
     raise ValueError(f"unknown language_encoder {cfg.language_encoder!r}; "

@@ -212,6 +212,18 @@ def token_codes(tokens: torch.Tensor) -> torch.Tensor:
     return torch.where(ok, code, -1)
 
 
+@torch.no_grad()
+def token_vectors(tf: Transformer, texts: list[str], batch_size: int = 128):
+    """The frozen transformer's last hidden states, a batch of texts at a time, on the CPU.
+
+    Yields ``(hidden (b, tokens, D) float32, mask (b, tokens) bool)``; ``mask`` is False on padding.
+    """
+    for i in range(0, len(texts), batch_size):
+        enc = tf.tokenizer(list(texts[i:i + batch_size]), padding=True, truncation=True,
+                           return_tensors="pt")
+        yield tf.model(**enc).last_hidden_state.float(), enc["attention_mask"].bool()
+
+
 # --------------------------------------------------------------------------- the encoder
 class PretrainedLanguageEncoder(nn.Module):
     """Frozen pretrained transformer -> one sentence vector per input, (B, output_dim).
@@ -251,21 +263,17 @@ class PretrainedLanguageEncoder(nn.Module):
         texts = check_texts("encode_texts", texts)
         return self._run_transformer(texts).to(self.table.device)
 
-    @torch.no_grad()
-    def _run_transformer(self, texts: list[str], batch_size: int = 128) -> torch.Tensor:
+    def _run_transformer(self, texts: list[str]) -> torch.Tensor:
         """Texts -> pooled last hidden states (B, output_dim), on the CPU."""
-        tf, out = self.transformer, [torch.zeros(0, self.output_dim)]
-        for i in range(0, len(texts), batch_size):
-            enc = tf.tokenizer(list(texts[i:i + batch_size]), padding=True, truncation=True,
-                               return_tensors="pt")
-            hidden = tf.model(**enc).last_hidden_state.float()              # (b, tokens, D)
+        out = [torch.zeros(0, self.output_dim)]
+        for hidden, mask in token_vectors(self.transformer, texts):      # (b, tokens, D), (b, tokens)
             if self.pooling == "cls":
                 out.append(hidden[:, 0])
             else:
                 # Deviation from paper: the mean over real tokens only (what all-MiniLM-L6-v2
                 # was trained for); the authors' code also averaged the padding.
-                mask = enc["attention_mask"][..., None].float()              # (b, tokens, 1)
-                out.append((hidden * mask).sum(1) / mask.sum(1))
+                weight = mask[..., None].float()                            # (b, tokens, 1)
+                out.append((hidden * weight).sum(1) / weight.sum(1))
         return torch.cat(out)
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
@@ -325,4 +333,4 @@ class PretrainedLanguageEncoder(nn.Module):
 __all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError",
            "Transformer", "check_texts", "fixed_token_rows", "input_text",
            "load_transformer", "model_name", "model_source", "token_codes",
-           "tokens_to_text"]
+           "token_vectors", "tokens_to_text"]

@@ -1,0 +1,134 @@
+"""Attention pooling over the frozen transformer's token vectors (not in the paper).
+
+Paper, Sec. 3 ("Language Autoencoder", last paragraph): PGAE-BERT reads its input
+with a frozen pretrained transformer and feeds the GMU one sentence vector, the
+mean of the token vectors (:mod:`pgae_lite.pretrained`). In a free-form
+instruction most tokens are frame and carrier words (``could you please ...``):
+the mean dilutes the few that say action, colour and speed. This encoder keeps
+the transformer frozen and learns where to look. With K heads over the token
+vectors x_1..x_T of one input (padding excluded):
+
+    a_tk = softmax_t(w_k · x_t + b_k)          attention of head k over the tokens
+    f    = 1/K Σ_k Σ_t a_tk x_t                 (D,), into the GMU as PGAE-BERT's f
+
+w and b start at zero, so at the start of training every head weighs the real
+tokens equally and f is PGAE-BERT's mean-pooled vector. The K·(D+1) weights are
+the encoder's only trained parameters. As in PGAE-BERT, the token vectors of the
+869 inputs the vocabulary allows are computed once and cached on disk; any other
+text runs through the transformer. Used by the free-form variant
+``PGAE-BERT-phrasings`` (:data:`pgae_lite.config.TRAININGS`), never by the paper's
+PGAE-BERT.
+"""
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from .pretrained import (WORDS, Transformer, check_texts, fixed_token_rows, load_transformer, model_name,
+                         token_codes, token_vectors, tokens_to_text)
+from .signals import SIGNALS
+from .utils import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
+
+#: Attention heads (K). Deviation from paper: chosen on generated validation sentences
+#: (experiments/validation_readback.py's grammar seed), never on the test paraphrases.
+HEADS = 4
+
+
+class AttentionPooling(nn.Module):
+    """Token vectors (B, T, D) and their mask (B, T) -> f (B, D), K heads averaged."""
+
+    def __init__(self, dim: int, heads: int = HEADS):
+        super().__init__()
+        self.score = nn.Linear(dim, heads)                           # w_k, b_k for k = 1..K
+        nn.init.zeros_(self.score.weight)                            # uniform attention: the mean at start
+        nn.init.zeros_(self.score.bias)
+
+    def forward(self, states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        scores = self.score(states).masked_fill(~mask[..., None], float("-inf"))   # (B, T, K)
+        a = scores.softmax(dim=1)                                    # a_tk = softmax_t(w_k · x_t + b_k)
+        return torch.einsum("btk,btd->bd", a, states) / a.shape[-1]  # f = 1/K Σ_k Σ_t a_tk x_t
+
+
+def padded_token_vectors(tf: Transformer, texts: list[str]) -> tuple[torch.Tensor, torch.Tensor]:
+    """Texts -> token vectors (B, T, D) and mask (B, T), padded to the longest text, on the CPU."""
+    pieces = list(token_vectors(tf, texts))
+    longest = max((h.shape[1] for h, _ in pieces), default=1)
+    states = torch.cat([nn.functional.pad(h, (0, 0, 0, longest - h.shape[1])) for h, _ in pieces])
+    mask = torch.cat([nn.functional.pad(m, (0, longest - m.shape[1])) for _, m in pieces])
+    return states, mask
+
+
+def cached_token_vectors(tf: Transformer, texts: list[str], what: str,
+                         dtype: torch.dtype = torch.float32) -> tuple[torch.Tensor, torch.Tensor]:
+    """:func:`padded_token_vectors`, kept on disk under a digest of the texts and the model."""
+    key = config_digest({"texts": texts, "encoder": tf.digest, "dtype": str(dtype)})
+    path = cache_dir() / "embeddings" / f"{what}-tokens-{key}.pt"
+    if path.exists():
+        try:
+            saved = load_torch(path, ("states", "mask"), what=f"{what} token cache")
+            if saved["states"].shape[:2] == saved["mask"].shape and saved["states"].isfinite().all():
+                return saved["states"], saved["mask"]
+        except CorruptCheckpointError:       # damaged: computed again, never trusted
+            pass
+    states, mask = padded_token_vectors(tf, texts)
+    states = states.to(dtype)
+    save_torch({"states": states, "mask": mask}, path)               # atomic write
+    return states, mask
+
+
+class AttentivePretrainedEncoder(nn.Module):
+    """Frozen pretrained transformer -> token vectors -> trained attention pooling -> (B, output_dim).
+
+    Called like PGAE-BERT's :class:`~pgae_lite.pretrained.PretrainedLanguageEncoder`:
+    ``lang_tokens`` rows in ``forward``, any text in :meth:`encode_texts`. The transformer
+    stays outside the module tree (frozen, in no optimiser); the pooling is trained.
+    """
+
+    pooling = "attention"
+
+    def __init__(self, name: str | None = None, heads: int = HEADS):
+        super().__init__()
+        self.name = model_name(name)
+        self.output_dim = int(self.transformer.model.config.hidden_size)
+        rows = fixed_token_rows()
+        self.texts = [tokens_to_text(r) for r in rows]
+        states, mask = cached_token_vectors(self.transformer, self.texts, "fixed")
+        row_of_code = torch.full((len(SIGNALS) * WORDS ** 3,), -1)
+        row_of_code[token_codes(rows)] = torch.arange(len(rows))
+        self.register_buffer("states", states, persistent=False)             # (869, T, D)
+        self.register_buffer("mask", mask, persistent=False)                 # (869, T)
+        self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
+        self.attention = AttentionPooling(self.output_dim, heads)
+
+    @property
+    def transformer(self) -> Transformer:
+        """The loaded tokenizer and model (loaded on first use in this process)."""
+        return load_transformer(self.name)
+
+    def pool(self, states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        """Token vectors (B, T, D) and mask (B, T) -> f (B, D) on this encoder's device."""
+        device = self.mask.device
+        return self.attention(states.to(device, torch.float32), mask.to(device))
+
+    def encode_texts(self, texts: list[str]) -> torch.Tensor:
+        """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``."""
+        texts = check_texts("encode_texts", texts)
+        return self.pool(*padded_token_vectors(self.transformer, texts))
+
+    def forward(self, tokens: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
+        """``lang_tokens`` (B, 5) -> (B, output_dim); rows outside the fixed 869 run the transformer."""
+        codes = token_codes(tokens)
+        rows = torch.where(codes >= 0, self.row_of_code[codes.clamp(min=0)], -1).to(self.mask.device)
+        out = self.pool(self.states[rows.clamp(min=0)], self.mask[rows.clamp(min=0)])
+        missing = (rows < 0).nonzero().flatten()
+        if len(missing):
+            out = out.index_put((missing,), self.encode_texts(
+                [tokens_to_text(tokens[i]) for i in missing.tolist()]))
+        return out
+
+    def extra_repr(self) -> str:
+        return f"{self.name!r}, pooling='attention', output_dim={self.output_dim}, transformer frozen"
+
+
+__all__ = ["AttentionPooling", "AttentivePretrainedEncoder", "HEADS", "cached_token_vectors",
+           "padded_token_vectors"]
