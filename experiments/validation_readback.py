@@ -1,6 +1,6 @@
 """Validation readback: free-form language measured without touching the test paraphrases.
 
-    python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242]
+    python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
@@ -10,6 +10,9 @@ free-form variant is chosen on; ``pgae_lite/paraphrases.tsv`` stays the test
 set (``benchmarks/free_language.py``). The "held-out words" subset holds the
 sentences with a word of :func:`pgae_lite.phrase_lexicon.held_out_words`.
 Models are trained with the book profile, or loaded from the cache.
+With ``--closed`` each episode is also told its sentence with ``execute`` and
+run in the simulator's closed loop (:func:`pgae_lite.instructions.execute_paraphrases`),
+and the failures are counted by the simulator's reason.
 """
 import argparse
 
@@ -20,16 +23,21 @@ from pgae_lite.evaluate import predict
 from pgae_lite.patterns import Pattern
 from pgae_lite.phrase_lexicon import held_out_words, words_of
 from pgae_lite.phrasings import phrasings
-from pgae_lite.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.config import get_profile
+from pgae_lite.instructions import execute_paraphrases
+from pgae_lite.paraphrases import Paraphrase
+from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.pretrained import input_text
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("models", nargs="+", help="TRAINING:SEED, e.g. PGAE-BERT-phrasings:0")
 parser.add_argument("--seed", type=int, default=4242, help="the phrasing grammar's seed (not a training one)")
+parser.add_argument("--closed", action="store_true", help="also execute the sentences in the closed loop")
 args = parser.parse_args()
 torch.set_num_threads(1)
 
-test = simulated_dataset("book", progress=False).split("test")
+data = simulated_dataset("book", progress=False)
+test = data.split("test")
 held = set(held_out_words())
 sentences = {}
 texts, unseen = [], []
@@ -51,3 +59,11 @@ for spec in args.models:
     print(f"{spec}: validation readback {100 * back.correct.mean():.2f}% "
           f"(held-out words {100 * back.correct[unseen].mean():.2f}% of {unseen.sum()}, "
           f"others {100 * back.correct[~unseen].mean():.2f}%)", flush=True)
+    if args.closed:   # 3 sentences per meaning, each told to the 2 episodes paraphrase_of gives it
+        said = [Paraphrase(t, *m) for m, ts in sentences.items() for t in ts[:3]]
+        cae, _ = trained_cae("book", "cpu", progress=False)
+        table = execute_paraphrases(trained.model, cae, trained.normaliser, data, said,
+                                    config=get_profile("book").data, progress=False)
+        failed = table[~table.closed_passed]
+        print(f"{spec}: validation closed loop {100 * table.closed_passed.mean():.2f}% of {len(table)}; "
+              f"failures by reason: {failed.closed_reason.value_counts().to_dict()}", flush=True)
