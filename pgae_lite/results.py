@@ -68,7 +68,8 @@ def measured(name: str) -> str:
     """When, where and how a result file was made, as one line of text."""
     r = load(name)
     m = r.get("machine", {})
-    where = f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, {m.get('threads', '?')} threads"
+    threads = m.get("threads", "?")
+    where = f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, {threads} thread{'' if threads == 1 else 's'}"
     if m.get("gpu"):
         where += f", {m['gpu']}"
     return (f"measured {r['date'][:10]} at commit {r['commit']} ({where}, torch {m.get('torch', '?')}, "
