@@ -24,9 +24,8 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from .pretrained import (WORDS, Transformer, check_texts, fixed_token_rows, load_transformer, model_name,
-                         token_codes, token_vectors, tokens_to_text)
-from .signals import SIGNALS
+from .pretrained import (Transformer, check_texts, fixed_inputs, load_transformer, model_name, table_rows,
+                         token_vectors, tokens_to_text)
 from .utils import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 
 #: Attention heads (K). Deviation from paper: chosen on generated validation sentences
@@ -90,11 +89,8 @@ class AttentivePretrainedEncoder(nn.Module):
         super().__init__()
         self.name = model_name(name)
         self.output_dim = int(self.transformer.model.config.hidden_size)
-        rows = fixed_token_rows()
-        self.texts = [tokens_to_text(r) for r in rows]
+        self.texts, row_of_code = fixed_inputs()
         states, mask = cached_token_vectors(self.transformer, self.texts, "fixed")
-        row_of_code = torch.full((len(SIGNALS) * WORDS ** 3,), -1)
-        row_of_code[token_codes(rows)] = torch.arange(len(rows))
         self.register_buffer("states", states, persistent=False)             # (869, T, D)
         self.register_buffer("mask", mask, persistent=False)                 # (869, T)
         self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
@@ -117,9 +113,9 @@ class AttentivePretrainedEncoder(nn.Module):
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
         """``lang_tokens`` (B, 5) -> (B, output_dim); rows outside the fixed 869 run the transformer."""
-        codes = token_codes(tokens)
-        rows = torch.where(codes >= 0, self.row_of_code[codes.clamp(min=0)], -1).to(self.mask.device)
-        out = self.pool(self.states[rows.clamp(min=0)], self.mask[rows.clamp(min=0)])
+        rows = table_rows(tokens, self.row_of_code).to(self.mask.device)
+        known = rows.clamp(min=0)
+        out = self.pool(self.states[known], self.mask[known])
         missing = (rows < 0).nonzero().flatten()
         if len(missing):
             out = out.index_put((missing,), self.encode_texts(

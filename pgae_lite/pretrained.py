@@ -212,6 +212,20 @@ def token_codes(tokens: torch.Tensor) -> torch.Tensor:
     return torch.where(ok, code, -1)
 
 
+def fixed_inputs() -> tuple[list[str], torch.Tensor]:
+    """The texts of the 869 fixed inputs, and each token code's row among them (-1: none), (5·23³,)."""
+    rows = fixed_token_rows()
+    row_of_code = torch.full((len(SIGNALS) * WORDS ** 3,), -1)
+    row_of_code[token_codes(rows)] = torch.arange(len(rows))
+    return [tokens_to_text(r) for r in rows], row_of_code
+
+
+def table_rows(tokens: torch.Tensor, row_of_code: torch.Tensor) -> torch.Tensor:
+    """``lang_tokens`` (B, 5) -> each row's index among the fixed inputs (B,), -1 for any other text."""
+    codes = token_codes(tokens)
+    return torch.where(codes >= 0, row_of_code[codes.clamp(min=0)], -1)
+
+
 @torch.no_grad()
 def token_vectors(tf: Transformer, texts: list[str], batch_size: int = 128):
     """The frozen transformer's last hidden states, a batch of texts at a time, on the CPU.
@@ -241,11 +255,8 @@ class PretrainedLanguageEncoder(nn.Module):
             raise ValueError(f"unknown pooling {pooling!r}; the options are: {', '.join(POOLINGS)}")
         self.name, self.pooling = model_name(name), pooling
         self.output_dim = int(self.transformer.model.config.hidden_size)
-        rows = fixed_token_rows()
-        self.texts = [tokens_to_text(r) for r in rows]
+        self.texts, row_of_code = fixed_inputs()
         table, self.table_source, self.table_seconds = self._load_or_compute_table()
-        row_of_code = torch.full((len(SIGNALS) * WORDS ** 3,), -1)
-        row_of_code[token_codes(rows)] = torch.arange(len(rows))
         self.register_buffer("table", table, persistent=False)               # (869, D)
         self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
 
@@ -282,8 +293,7 @@ class PretrainedLanguageEncoder(nn.Module):
         ``lengths`` is not needed (a row's text ends at its first <EOS>); it is accepted so
         that both language encoders are called the same way.
         """
-        codes = token_codes(tokens)
-        rows = torch.where(codes >= 0, self.row_of_code[codes.clamp(min=0)], -1)
+        rows = table_rows(tokens, self.row_of_code)
         out = self.table[rows.clamp(min=0)]
         missing = (rows < 0).nonzero().flatten()
         if len(missing):
@@ -332,5 +342,5 @@ class PretrainedLanguageEncoder(nn.Module):
 
 __all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError",
            "Transformer", "check_texts", "fixed_token_rows", "input_text",
-           "load_transformer", "model_name", "model_source", "token_codes",
+           "fixed_inputs", "load_transformer", "model_name", "model_source", "table_rows", "token_codes",
            "token_vectors", "tokens_to_text"]
