@@ -1,7 +1,7 @@
 """Free-form language: the paper's frozen PGAE-BERT against PGAE-BERT trained on phrasings.
 
     python benchmarks/free_language.py [--trainings PGAE-BERT PGAE-BERT-phrasings] [--seeds 0]
-                                       [--profile book] [--threads 1] [--no-closed]
+                                       [--profile book] [--threads 1] [--no-closed] [--workers 2]
     python benchmarks/free_language.py --original ../shared/pgae-original-data
                                        [--trainings PGAE-BERT-phrasings] [--seeds 0 1 2]
 
@@ -16,7 +16,10 @@ never trained on), and measured three ways:
   to help: is the generated description (action colour speed) the intended one?
 - *execution*: the paraphrase with ``execute`` in the simulator, open loop (the
   decoder reads the recorded frames of the right action: it overstates
-  understanding) and closed loop (its own camera);
+  understanding) and closed loop (its own camera); by two routes
+  (:data:`pgae_lite.instructions.ROUTES`): ``direct``, the paper's, the sentence's
+  features into execute; ``said back`` (``said_back_*`` keys), the model's
+  readback words executed;
 - the canonical Table 1 cells of the model on the same data.
 
 The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
@@ -43,13 +46,17 @@ import tempfile
 import time
 from pathlib import Path
 
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+
 import numpy as np
+import torch
 
 from harness import Benchmark
 from pgae_lite.closedloop import variation_of
 from pgae_lite.config import TRAININGS, get_profile, training_profile
 from pgae_lite.evaluate import evaluate, predict
-from pgae_lite.instructions import execute_paraphrases, paraphrase_of
+from pgae_lite.instructions import ROUTES, execute_paraphrases, paraphrase_of
 from pgae_lite.language import SIGNALS, VOCABULARY
 from pgae_lite.original import load_original
 from pgae_lite.paraphrases import load_paraphrases
@@ -112,11 +119,51 @@ def training_time(bench: Benchmark, args) -> None:
     bench.write({"runs": runs, "ratio": round(total["PGAE-BERT-phrasings"] / total["PGAE-BERT"], 2)})
 
 
+def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
+    """One model's readback, execution (both routes) and Table 1 on the 216 test episodes."""
+    torch.set_num_threads(1)                  # one core per worker: these networks gain nothing from two
+    data = simulated_dataset(profile, "cpu", progress=False)
+    cae, _ = trained_cae(profile, "cpu", progress=False)
+    test = data.split("test")
+    paraphrases = load_paraphrases()
+    told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
+    texts = [input_text("repeat language", t.text) for t in told]   # the readback's inputs
+    seen = training_words(training)
+    unseen = np.array([bool(words(t.text) - seen) for t in told])
+    trained = trained_pgae(training, profile, seed, device="cpu", progress=False)
+    model, norm = trained.model, trained.normaliser
+    cells, _ = evaluate(model, data, norm)
+    t0 = time.perf_counter()
+    back = predict(model, test, norm, "repeat language", language=model.language_encoder.encode_texts(texts))
+    run = {"training": training, "seed": seed, "episodes": len(told), "train_seconds": round(trained.seconds, 1),
+           "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
+           "readback_%": round(100 * back.correct.mean(), 2),
+           "unseen_episodes": int(unseen.sum()),
+           "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2) if unseen.any() else None,
+           "readback_wrong": [{"told": t.text, "understood": x}
+                              for t, x, ok in zip(told, back.text, back.correct) if not ok][:40]}
+    for route in ROUTES:   # "direct": the paper's execute of the sentence; "said back": its readback's words
+        table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=closed, route=route,
+                                    config=get_profile(profile).data, progress=False)
+        prefix = "" if route == "direct" else "said_back_"
+        for loop in ("open", "closed"):
+            if f"{loop}_passed" in table:
+                passed = table[f"{loop}_passed"].to_numpy()
+                run[f"{prefix}{loop}_success_%"] = round(100 * passed.mean(), 2)
+                if unseen.any():
+                    run[f"{prefix}{loop}_success_unseen_%"] = round(100 * passed[unseen].mean(), 2)
+    run["measure_seconds"] = round(time.perf_counter() - t0, 1)
+    print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1")}, flush=True)
+    return run
+
+
 def main() -> None:
     bench = Benchmark("free_language", __doc__, seeds=[0])
     bench.parser.add_argument("--trainings", nargs="+", default=["PGAE-BERT", "PGAE-BERT-phrasings",
                                                                   "PGAE-BERT-phrasings-held-out"])
     bench.parser.add_argument("--no-closed", action="store_true", help="open loop only (fast)")
+    bench.parser.add_argument("--workers", type=int, default=1,
+                              help="models measured side by side, each in its own process on one thread")
     bench.parser.add_argument("--original", default=None, help="the authors' data: canonical Table 1 only")
     bench.parser.add_argument("--time", action="store_true", help="the variant's training time against PGAE-BERT's")
     args = bench.parse()
@@ -124,42 +171,16 @@ def main() -> None:
         return original_table1(bench, args)
     if args.time:
         return training_time(bench, args)
-    data = simulated_dataset(args.profile, "cpu", progress=False)
-    cae, _ = trained_cae(args.profile, "cpu", progress=False)
-    test = data.split("test")
-    paraphrases = load_paraphrases()
-    told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
-    texts = [input_text("repeat language", t.text) for t in told]   # the readback's inputs
-    runs = []
-    for training in args.trainings:
-        seen = training_words(training)
-        unseen = np.array([bool(words(t.text) - seen) for t in told])
-        for seed in args.seeds:
-            trained = trained_pgae(training, args.profile, seed, device="cpu", progress=False)
-            model, norm = trained.model, trained.normaliser
-            cells, _ = evaluate(model, data, norm)
-            t0 = time.perf_counter()
-            back = predict(model, test, norm, "repeat language",
-                           language=model.language_encoder.encode_texts(texts))
-            run = {"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),
-                   "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
-                   "readback_%": round(100 * back.correct.mean(), 2),
-                   "unseen_episodes": int(unseen.sum()),
-                   "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2) if unseen.any() else None,
-                   "readback_wrong": [{"told": t.text, "understood": x}
-                                      for t, x, ok in zip(told, back.text, back.correct) if not ok][:40]}
-            table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=not args.no_closed,
-                                        config=get_profile(args.profile).data, progress=False)
-            for loop in ("open", "closed"):
-                if f"{loop}_passed" in table:
-                    passed = table[f"{loop}_passed"].to_numpy()
-                    run[f"{loop}_success_%"] = round(100 * passed.mean(), 2)
-                    if unseen.any():
-                        run[f"{loop}_success_unseen_%"] = round(100 * passed[unseen].mean(), 2)
-            run["measure_seconds"] = round(time.perf_counter() - t0, 1)
-            print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1")}, flush=True)
-            runs.append(run)
-    bench.write({"paraphrases": len(paraphrases), "episodes": len(told), "runs": runs})
+    simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
+    trained_cae(args.profile, "cpu", progress=False)
+    jobs = [(training, seed, args.profile, not args.no_closed) for training in args.trainings for seed in args.seeds]
+    if args.workers > 1:
+        with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
+            runs = list(pool.map(measure, *zip(*jobs)))
+    else:
+        runs = [measure(*job) for job in jobs]
+    bench.write({"paraphrases": len(load_paraphrases()), "episodes": runs[0]["episodes"],
+                 "routes": list(ROUTES), "runs": runs})
 
 
 if __name__ == "__main__":   # recording the data spawns workers, which re-import this file

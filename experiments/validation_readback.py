@@ -1,6 +1,7 @@
 """Validation readback: free-form language measured without touching the test paraphrases.
 
     python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
+    python experiments/validation_readback.py PGAE-BERT-phrasings:0:input_noise=0.05
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
@@ -9,10 +10,11 @@ must name the intended action, colour and speed. This is the validation set a
 free-form variant is chosen on; ``pgae_lite/paraphrases.tsv`` stays the test
 set (``benchmarks/free_language.py``). The "held-out words" subset holds the
 sentences with a word of :func:`pgae_lite.phrase_lexicon.held_out_words`.
-Models are trained with the book profile, or loaded from the cache.
+Models are trained with the book profile, or loaded from the cache; ``name=value``
+after the seed changes one training option (a number) that the training itself does not set.
 With ``--closed`` each episode is also told its sentence with ``execute`` and
-run in the simulator's closed loop (:func:`pgae_lite.instructions.execute_paraphrases`),
-and the failures are counted by the simulator's reason.
+run in the simulator's closed loop (:func:`pgae_lite.instructions.execute_paraphrases`,
+``--routes direct "said back"``), and the failures are counted by the simulator's reason.
 """
 import argparse
 
@@ -20,19 +22,34 @@ import numpy as np
 import torch
 
 from pgae_lite.evaluate import predict
+from pgae_lite.language import LanguageError, parse_description
 from pgae_lite.patterns import Pattern
 from pgae_lite.phrase_lexicon import held_out_words, words_of
 from pgae_lite.phrasings import phrasings
 from pgae_lite.config import get_profile
-from pgae_lite.instructions import execute_paraphrases
+from pgae_lite.instructions import ROUTES, execute_paraphrases
 from pgae_lite.paraphrases import Paraphrase
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.pretrained import input_text
 
+
+def parse(text: str) -> tuple[str, ...] | None:
+    """A description's canonical (action, colour, speed), None for any other text."""
+    try:
+        return parse_description(text)
+    except LanguageError:
+        return None
+
+
+# the simulator's reasons for a failed episode, by kind (one failure may have several)
+REASONS = {"sideways": "sideways", "too little along": "along the direction", "other cube": "other cube"}
+
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-parser.add_argument("models", nargs="+", help="TRAINING:SEED, e.g. PGAE-BERT-phrasings:0")
+parser.add_argument("models", nargs="+", help="TRAINING:SEED[:OPTION=NUMBER], e.g. PGAE-BERT-phrasings:0")
 parser.add_argument("--seed", type=int, default=4242, help="the phrasing grammar's seed (not a training one)")
 parser.add_argument("--closed", action="store_true", help="also execute the sentences in the closed loop")
+parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
+                    help="how the closed loop reads the sentence (pgae_lite.instructions.ROUTES)")
 args = parser.parse_args()
 torch.set_num_threads(1)
 
@@ -52,8 +69,10 @@ for i, number in enumerate(test.pattern):
 unseen = np.array(unseen)
 
 for spec in args.models:
-    training, seed = spec.rsplit(":", 1)
-    trained = trained_pgae(training, "book", int(seed), device="cpu", progress=False)
+    training, seed, *options = spec.split(":")
+    options = dict(option.split("=") for option in options)
+    trained = trained_pgae(training, "book", int(seed), device="cpu", progress=False,
+                           **{k: int(v) if v.isdigit() else float(v) for k, v in options.items()})
     heard = trained.model.language_encoder.encode_texts(texts)
     back = predict(trained.model, test, trained.normaliser, "repeat language", language=heard)
     print(f"{spec}: validation readback {100 * back.correct.mean():.2f}% "
@@ -62,8 +81,13 @@ for spec in args.models:
     if args.closed:   # 3 sentences per meaning, each told to the 2 episodes paraphrase_of gives it
         said = [Paraphrase(t, *m) for m, ts in sentences.items() for t in ts[:3]]
         cae, _ = trained_cae("book", "cpu", progress=False)
-        table = execute_paraphrases(trained.model, cae, trained.normaliser, data, said,
-                                    config=get_profile("book").data, progress=False)
-        failed = table[~table.closed_passed]
-        print(f"{spec}: validation closed loop {100 * table.closed_passed.mean():.2f}% of {len(table)}; "
-              f"failures by reason: {failed.closed_reason.value_counts().to_dict()}", flush=True)
+        for route in args.routes:
+            table = execute_paraphrases(trained.model, cae, trained.normaliser, data, said, route=route,
+                                        config=get_profile("book").data, progress=False)
+            reasons = table[~table.closed_passed].closed_reason
+            meant = [tuple(m.split()) for m in table.meaning]
+            right = np.mean([m == parse(a) for m, a in zip(meant, table.acted_on)])
+            kinds = {kind: int(reasons.str.contains(pattern).sum()) for kind, pattern in REASONS.items()}
+            print(f"{spec}: validation closed loop ({route}) {100 * table.closed_passed.mean():.2f}% of "
+                  f"{len(table)} (acted on the intended meaning: {100 * right:.2f}%); {len(reasons)} failures, "
+                  f"of which {kinds}", flush=True)

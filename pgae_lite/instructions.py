@@ -54,6 +54,34 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
     return encoder(tokens, torch.full((len(texts),), 5, device=device))
 
 
+ROUTES = ("direct", "said back")
+
+
+@torch.no_grad()
+def say_back(model: PGAE, data: PGAEDataset, normaliser: Normaliser, texts: list[str]) -> list[str]:
+    """Each instruction said back in the dataset's words (``repeat language``; sample i of ``data``
+    carries text i, whose action the model is not shown), e.g. ``"push red fast"``."""
+    texts = check_texts("say_back", texts)
+    if not hasattr(model.language_encoder, "encode_texts"):
+        raise ValueError("saying back free text needs PGAE-BERT's pretrained encoder; PGAE's LSTM reads "
+                         "descriptions only")
+    language = model.language_encoder.encode_texts([input_text("repeat language", t) for t in texts])
+    return predict(model, data, normaliser, "repeat language", language=language).text
+
+
+def acted_on(said: list[str], texts: list[str]) -> list[str]:
+    """What ``route="said back"`` executes: the words said back where they are a description
+    (action colour speed; hyphens read as spaces), else the instruction itself."""
+    out = []
+    for back, text in zip(said, texts):
+        try:
+            parse_description(back)
+            out.append(back.replace("-", " "))   # "move up", as training wrote it for the transformer
+        except LanguageError:
+            out.append(text)
+    return out
+
+
 def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
     """The paraphrase an episode is given: of its pattern's meaning, number ``variation`` mod how many there are.
 
@@ -68,7 +96,7 @@ def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -
 def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
                         paraphrases: list[Paraphrase] | None = None, split: str = "test", *,
                         limit: int | None = None, closed: bool = True, config: DatasetConfig | None = None,
-                        tracking: bool = True, progress: bool = True) -> pd.DataFrame:
+                        tracking: bool = True, progress: bool = True, route: str = "direct") -> pd.DataFrame:
     """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
 
     Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
@@ -80,8 +108,12 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     simulator (``open_*`` columns) and, if ``closed``,
     :func:`~pgae_lite.closedloop.closed_loop` (``closed_*``). nRMSE (%) is against
     the recorded joints of the episode, the intended action. ``limit``: that many
-    episodes, evenly spread.
+    episodes, evenly spread. ``route``: ``"direct"`` (the paper's: the instruction's
+    features) or ``"said back"`` (:func:`say_back`, then those words; the ``acted_on``
+    column).
     """
+    if route not in ROUTES:
+        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
     paraphrases = load_paraphrases() if paraphrases is None else paraphrases
     subset = data.split(split)
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
@@ -90,14 +122,17 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
         raise ValueError(f"no paraphrase has the meaning of any {split} episode")
     rows = rows[spread(len(rows), limit)]
     episodes, told = subset.subset(rows), [told[i] for i in rows]
-    language = instruction_features(model, [t.text for t in told])          # (N, D)
+    texts = [t.text for t in told]
+    if route == "said back":
+        texts = acted_on(say_back(model, episodes, normaliser, texts), texts)
+    language = instruction_features(model, texts)                             # (N, D)
     planned = predict(model, episodes, normaliser, "execute", language=language).joints   # the paper's execute
     joint_range = data.joint_range()
     return pd.DataFrame([
         {**execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
                            language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
-         "meaning": " ".join(told[k].meaning)}
+         "meaning": " ".join(told[k].meaning), "acted_on": texts[k]}
         for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
 
 
-__all__ = ["instruction_features", "paraphrase_of", "execute_paraphrases"]
+__all__ = ["ROUTES", "instruction_features", "say_back", "acted_on", "paraphrase_of", "execute_paraphrases"]

@@ -41,6 +41,7 @@ from .closedloop import closed_loop, open_loop, pattern_for
 from .config import PROFILES
 from .data import Normaliser, PGAEDataset, description_text
 from .errors import PGAELiteError
+from .instructions import ROUTES, acted_on
 from .language import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
     parse_description, tokenize
 from .patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
@@ -206,7 +207,8 @@ def _reader_text(model: PGAE, signal: str, text: str) -> tuple[str, ...] | None:
 @torch.no_grad()
 def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, data: PGAEDataset,
          signal: str = "execute", arrangement: int = 0, action: int = 0, text: str | None = None, *,
-         variation: int = 0, loop: str | None = "open", config: DatasetConfig | None = None) -> PlayResult:
+         variation: int = 0, loop: str | None = "open", config: DatasetConfig | None = None,
+         route: str = "direct") -> PlayResult:
     """Run ``model`` with one signal on the recorded episode of (``arrangement``, ``action``), or of ``text``.
 
     ``text``: a description, or with PGAE-BERT any instruction (see the module
@@ -214,13 +216,16 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     ``"open"`` (:func:`~pgae_lite.closedloop.open_loop`), ``"closed"`` (execute
     only: :func:`~pgae_lite.closedloop.closed_loop`, which needs ``cae``) or
     None (no simulation). ``config``: the simulated dataset's (default: found
-    from ``data``). Raises LanguageError or ValueError (a TypeError for a wrong type),
+    from ``data``). ``route``: free text under ``execute`` is executed ``"direct"``
+    or ``"said back"`` (its readback's words: :mod:`pgae_lite.instructions`). Raises LanguageError or ValueError (a TypeError for a wrong type),
     with a readable message, for a bad signal, text, choice or object.
     """
     check_objects(model, cae, normaliser, data, config)
     pattern_number(arrangement, action)                    # checks both
     instance_of("text", text, str, "a description (a string)", optional=True)
     signal, text = normalise_signal(signal), (text or "").strip()
+    if route not in ROUTES:
+        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
     if loop not in ("open", "closed", None):
         raise ValueError(f"unknown loop {loop!r}; the options are: 'open', 'closed', None")
     if loop == "closed" and (signal != "execute" or cae is None):
@@ -241,6 +246,15 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
 
     model.eval()
     zero = torch.zeros(1, dtype=torch.long)
+    understood = None
+    if reads_words and text:                               # readback: the same words, said back, no action shown
+        back_language = model.language_encoder.encode_texts([input_text("repeat language", said)]) if free else None
+        back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
+        understood = decode(back["logits"][0].argmax(-1).cpu())
+    if free and route == "said back" and signal == "execute":   # act on its own words
+        said = acted_on([understood], [said])[0]
+        told = input_text(signal, said)
+        language = model.language_encoder.encode_texts([told])
     batch = make_batch(tensors, zero, signal_ids(signal, 1), zero)
     out = model(batch, language=language)
     length = int(data.lengths[row])
@@ -248,11 +262,6 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     target = normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], batch.joint_target], 1))[0, :length]
     joints, target = joints.cpu().numpy(), target.cpu().numpy()
     generated = decode(out["logits"][0].argmax(-1).cpu())
-    understood = None
-    if reads_words and text:                               # readback: the same words, said back, no action shown
-        back_language = model.language_encoder.encode_texts([input_text("repeat language", said)]) if free else None
-        back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
-        understood = decode(back["logits"][0].argmax(-1).cpu())
     expected = [tuple(VOCABULARY[w] for w in alt) for alt in Pattern.from_number(pattern).descriptions()]
 
     config = config or simulator_config(data)
@@ -304,11 +313,13 @@ class Playground:
                            layout=w.Layout(width="32em"))
         self.loop = w.Dropdown(options=[("open loop", "open"), ("closed loop (execute)", "closed"), ("no robot", None)],
                                description="robot")
+        self.route = w.Dropdown(options=[("the sentence", "direct"), ("what it said back", "said back")],
+                                description="act on")            # free text under execute (PGAE-BERT)
         self.button = w.Button(description="Run", button_style="primary", icon="play")
         self.output = w.Output()
         self.button.on_click(self.run)
         self.widget = w.VBox([w.HBox([self.model, self.loop]), self.signal, w.HBox([self.arrangement, self.action]),
-                              w.HBox([self.text, self.variation]), self.button, self.output])
+                              w.HBox([self.text, self.variation]), self.route, self.button, self.output])
 
     def run(self, _button=None) -> None:
         """Call :func:`play` with the widgets' values and put what it made (or the error) in ``output``."""
@@ -321,7 +332,7 @@ class Playground:
         try:
             self.result = play(model, self.cae, normaliser, self.data, self.signal.value, self.arrangement.value,
                                self.action.value, self.text.value, variation=self.variation.value,
-                               loop=self.loop.value, config=self.config)
+                               loop=self.loop.value, config=self.config, route=self.route.value)
             shown = self.result.displays(self.every)
         except (ValueError, PGAELiteError) as e:   # the reader's choice, not a bug
             self.message = str(e)

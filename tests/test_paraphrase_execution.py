@@ -15,7 +15,7 @@ from pgae_lite.closedloop import closed_loop, success_summary
 from pgae_lite.config import get_profile
 from pgae_lite.data import description_text
 from pgae_lite.evaluate import predict
-from pgae_lite.instructions import execute_paraphrases, instruction_features, paraphrase_of
+from pgae_lite.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
 from pgae_lite.language import LanguageError
 from pgae_lite.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.patterns import Pattern
@@ -99,3 +99,30 @@ def test_the_lstm_rejects_paraphrases_naming_the_unknown_words(smoke):
     table = execute_paraphrases(lstm.model, cae, lstm.normaliser, data, own, config=SMOKE, closed=False,
                                 progress=False)
     assert list(table["id"]) == ["sim/116-0"] and table["meaning"].item() == "slide cyan fast"
+
+
+def test_said_back_route_executes_the_models_own_words(smoke):
+    data, cae, bert, lstm = smoke
+    test = data.split("test").subset(list(range(4)))
+    told = ["would you push the red block away, slowly", "pull blue fast"]
+    back = say_back(bert.model, test.subset([0, 1]), bert.normaliser, told)
+    expected = predict(bert.model, test.subset([0, 1]), bert.normaliser, "repeat language",
+                       language=bert.model.language_encoder.encode_texts(
+                           [f"repeat language {t}" for t in told])).text
+    assert back == expected
+    # a description said back is executed; anything else leaves the instruction itself
+    assert acted_on(["move-up red slowly", "push push"], told) == ["move up red slowly", told[1]]
+    table = execute_paraphrases(bert.model, cae, bert.normaliser, data, config=SMOKE, closed=False,
+                                progress=False, route="said back", limit=3)
+    direct = execute_paraphrases(bert.model, cae, bert.normaliser, data, config=SMOKE, closed=False,
+                                 progress=False, limit=3)
+    assert list(table["description"]) == list(direct["description"])          # told the same paraphrase
+    assert (direct["acted_on"] == direct["description"]).all()
+    episodes = data.split("test")
+    rows = [list(episodes.ids).index(i) for i in table["id"]]
+    said = say_back(bert.model, episodes.subset(rows), bert.normaliser, list(table["description"]))
+    assert list(table["acted_on"]) == acted_on(said, list(table["description"]))
+    with pytest.raises(ValueError, match="unknown route 'both'; the options are: 'direct', 'said back'"):
+        execute_paraphrases(bert.model, cae, bert.normaliser, data, route="both")
+    with pytest.raises(ValueError, match="needs PGAE-BERT"):
+        say_back(lstm.model, test.subset([0]), lstm.normaliser, ["push red slow"])

@@ -18,7 +18,7 @@ from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
 from pgae_lite.closedloop import pattern_for
 from pgae_lite.data import Normaliser
 from pgae_lite.evaluate import predict
-from pgae_lite.instructions import instruction_features
+from pgae_lite.instructions import acted_on, instruction_features
 from pgae_lite.language import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
 from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_parts
@@ -188,6 +188,14 @@ def test_pgae_bert_reads_free_text(toy):
     said = predict(model, toy.subset([row]), normaliser, "repeat language",
                    language=model.language_encoder.encode_texts([input_text("repeat language", text)]))
     assert r.understood == said.text[0]
+    # "said back": it acts on its own readback's words (the text itself if they are no description)
+    acted = acted_on([r.understood], [text])[0]
+    back = play(model, None, normaliser, toy, "execute", 0, 3, text, loop=None, route="said back")
+    assert back.told == f"execute {acted}" and back.understood == r.understood
+    own = predict(model, toy.subset([row]), normaliser, "execute", language=instruction_features(model, [acted]))
+    np.testing.assert_allclose(back.joints, own.joints[0, :len(back.joints)], atol=1e-5)
+    with pytest.raises(ValueError, match="unknown route 'both'; the options are: 'direct', 'said back'"):
+        play(model, None, normaliser, toy, "execute", 0, 3, text, loop=None, route="both")
     with pytest.raises(LanguageError, match="'describe' reads no words"):
         play(model, None, normaliser, toy, "describe", 0, 3, text, loop=None)
     # In the widget, with both models to choose from.
