@@ -3,7 +3,7 @@
     python benchmarks/free_language.py [--trainings PGAE-BERT PGAE-BERT-phrasings] [--seeds 0]
                                        [--profile book] [--threads 1] [--no-closed] [--workers 2]
     python benchmarks/free_language.py --original ../shared/pgae-original-data
-                                       [--trainings PGAE-BERT-phrasings] [--seeds 0 1 2]
+                                       [--trainings PGAE-BERT-phrasings] [--seeds 0 1 2] [--workers 2]
 
 Both models are trained (or loaded from the cache) on the profile's simulated
 data: ``PGAE-BERT`` reads the dataset's descriptions only; ``PGAE-BERT-phrasings``
@@ -80,21 +80,25 @@ def training_words(training: str) -> set[str]:
     return seen
 
 
+def original_run(training: str, seed: int, profile_name: str, path: str) -> dict:
+    """One training's canonical Table 1 on the authors' data (resumable under benchmarks/out/)."""
+    torch.set_num_threads(1)
+    data = load_original(path)
+    profile = training_profile(get_profile(profile_name, seed=seed), training)
+    out = Path("benchmarks/out") / f"free_language-original-{profile_name}-{training}-s{seed}"
+    trained = train(data, profile, out_dir=out, progress=False)
+    cells, _ = evaluate(trained.model, data, trained.normaliser)
+    run = {"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),
+           "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}}
+    print(run, flush=True)
+    return run
+
+
 def original_table1(bench: Benchmark, args) -> None:
     """Each training's canonical Table 1 on the authors' data (e.g. for the variant, next to the paper's row)."""
     bench.name = "free_language-original"
-    data = load_original(args.original)
-    runs = []
-    for training in args.trainings:
-        for seed in args.seeds:
-            profile = training_profile(get_profile(args.profile, seed=seed), training)
-            out = Path("benchmarks/out") / f"free_language-original-{args.profile}-{training}-s{seed}"
-            trained = train(data, profile, out_dir=out, progress=False)
-            cells, _ = evaluate(trained.model, data, trained.normaliser)
-            runs.append({"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),
-                         "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}})
-            print(runs[-1], flush=True)
-    bench.write({"data": "authors'", "runs": runs})
+    jobs = [(training, seed, args.profile, args.original) for training in args.trainings for seed in args.seeds]
+    bench.write({"data": "authors'", "runs": side_by_side(original_run, jobs, args.workers)})
 
 
 def training_time(bench: Benchmark, args) -> None:
@@ -157,6 +161,14 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
     return run
 
 
+def side_by_side(work, jobs: list[tuple], workers: int) -> list[dict]:
+    """``work(*job)`` for each job, ``workers`` processes at a time (spawned), in the jobs' order."""
+    if workers <= 1:
+        return [work(*job) for job in jobs]
+    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+        return list(pool.map(work, *zip(*jobs)))
+
+
 def main() -> None:
     bench = Benchmark("free_language", __doc__, seeds=[0])
     bench.parser.add_argument("--trainings", nargs="+", default=["PGAE-BERT", "PGAE-BERT-phrasings",
@@ -174,11 +186,7 @@ def main() -> None:
     simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
     trained_cae(args.profile, "cpu", progress=False)
     jobs = [(training, seed, args.profile, not args.no_closed) for training in args.trainings for seed in args.seeds]
-    if args.workers > 1:
-        with ProcessPoolExecutor(args.workers, mp_context=get_context("spawn")) as pool:
-            runs = list(pool.map(measure, *zip(*jobs)))
-    else:
-        runs = [measure(*job) for job in jobs]
+    runs = side_by_side(measure, jobs, args.workers)
     bench.write({"paraphrases": len(load_paraphrases()), "episodes": runs[0]["episodes"],
                  "routes": list(ROUTES), "runs": runs})
 
