@@ -2,6 +2,7 @@
 
     python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
     python experiments/validation_readback.py PGAE-BERT-phrasings:0:input_noise=0.05
+    python experiments/validation_readback.py "PGAE-BERT-phrasings:1:phrasing_signals=repeat language"
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
@@ -11,7 +12,8 @@ free-form variant is chosen on; ``pgae_lite/paraphrases.tsv`` stays the test
 set (``benchmarks/free_language.py``). The "held-out words" subset holds the
 sentences with a word of :func:`pgae_lite.phrase_lexicon.held_out_words`.
 Models are trained with the book profile, or loaded from the cache; ``name=value``
-after the seed changes one training option (a number) that the training itself does not set.
+after the seed changes one training option that the training itself does not set (a number,
+or names joined by ``+``).
 With ``--closed`` each episode is also told its sentence with ``execute`` and
 run in the simulator's closed loop (:func:`pgae_lite.instructions.execute_paraphrases`,
 ``--routes direct "said back"``), and the failures are counted by the simulator's reason.
@@ -26,7 +28,7 @@ from pgae_lite.language import LanguageError, parse_description
 from pgae_lite.patterns import Pattern
 from pgae_lite.phrase_lexicon import held_out_words, words_of
 from pgae_lite.phrasings import phrasings
-from pgae_lite.config import get_profile
+from pgae_lite.config import TrainConfig, get_profile
 from pgae_lite.instructions import ROUTES, execute_paraphrases
 from pgae_lite.paraphrases import Paraphrase
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
@@ -39,6 +41,13 @@ def parse(text: str) -> tuple[str, ...] | None:
         return parse_description(text)
     except LanguageError:
         return None
+
+
+def option_value(name: str, text: str):
+    """A training option's value from the command line: a number, or names joined by '+' for a tuple."""
+    if isinstance(getattr(TrainConfig(), name), tuple):
+        return tuple(text.split("+"))
+    return int(text) if text.isdigit() else float(text)
 
 
 # the simulator's reasons for a failed episode, by kind (one failure may have several)
@@ -72,7 +81,7 @@ for spec in args.models:
     training, seed, *options = spec.split(":")
     options = dict(option.split("=") for option in options)
     trained = trained_pgae(training, "book", int(seed), device="cpu", progress=False,
-                           **{k: int(v) if v.isdigit() else float(v) for k, v in options.items()})
+                           **{k: option_value(k, v) for k, v in options.items()})
     heard = trained.model.language_encoder.encode_texts(texts)
     back = predict(trained.model, test, trained.normaliser, "repeat language", language=heard)
     print(f"{spec}: validation readback {100 * back.correct.mean():.2f}% "

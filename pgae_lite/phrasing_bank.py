@@ -4,7 +4,8 @@ Paper, Sec. 3: PGAE-BERT's pretrained encoder "has the potential to recognise
 unseen natural language", but trained on the dataset's three-word descriptions
 alone it reads a free-form instruction as something far from anything it was
 trained on. With ``TrainConfig.phrasings`` = K > 0, every sample whose signal
-takes a description (execute, repeat both, repeat language) reads, with
+takes a description (execute, repeat both, repeat language; or those of
+``TrainConfig.phrasing_signals``) reads, with
 probability :data:`PHRASING_PROB`, one of K sentences that say its
 description in other words (:func:`pgae_lite.phrasings.phrasings`, a grammar
 and lexicon written for the purpose, independent of the held-out test
@@ -39,7 +40,7 @@ class PhrasingBank:
     """Sentence vectors of K phrasings per (signal, meaning): a tensor (3, 36, K, D)."""
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
-                 lexicon: PhraseLexicon | None = None):
+                 lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None):
         if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
@@ -69,9 +70,11 @@ class PhrasingBank:
         for word, canonical in CANONICAL.items():
             slot = next(slot for slot in SLOTS if canonical in slot)
             self.slot_index[VOCABULARY.index(word)] = slot.index(canonical)
-        # signal -> its row in the bank (-1: the signal takes no description)
+        # signal -> its row in the bank (-1: the signal reads no phrasings; all are encoded, one cache)
         self.signal_row = torch.full((len(SIGNALS),), -1, dtype=torch.long)
-        self.signal_row[list(TEXT_SIGNALS)] = torch.arange(len(TEXT_SIGNALS))
+        for row, s in enumerate(TEXT_SIGNALS):
+            if signals is None or SIGNALS[s] in signals:
+                self.signal_row[s] = row
 
     def meanings(self, tokens: torch.Tensor) -> torch.Tensor:
         """``lang_tokens`` (B, 5) with a description -> meaning index 0..35 (B,)."""

@@ -185,7 +185,8 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
     if cfg.phrasings:                       # free-form language (phrasing_bank.py), PGAE-BERT only
         from .phrase_lexicon import training_lexicon
         from .phrasing_bank import PhrasingBank
-        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words))
+        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words),
+                            cfg.phrasing_signals)
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:

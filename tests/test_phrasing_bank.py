@@ -62,6 +62,23 @@ def test_features_swap_only_samples_with_a_description(bert, toy_tensors):
     assert 0 < changed[takes_text].float().mean() < 1         # about half of the others
 
 
+def test_phrasing_signals_choose_which_samples_read_phrasings(bert, toy_tensors):
+    bank = PhrasingBank(bert.language_encoder, 3, signals=("repeat language",))
+    index = torch.arange(40)
+    signal = torch.arange(40) % 5
+    batch = make_batch(toy_tensors, index, signal, index % 8)
+    base = bert.language_encoder(batch.lang_tokens, batch.lang_lengths)
+    changed = (bank.features(bert, batch, torch.Generator().manual_seed(0)) != base).any(1)
+    reads = signal == SIGNALS.index("repeat language")
+    assert not changed[~reads].any() and changed[reads].any()
+    assert "phrasing_signals" not in get_profile("book").to_dict()["train"]   # default: the keys of before
+    chosen = get_profile("book", phrasing_signals=["repeat language"])
+    assert chosen.train.phrasing_signals == ("repeat language",)
+    assert chosen.to_dict()["train"]["phrasing_signals"] == ("repeat language",)
+    with pytest.raises(ValueError, match="phrasing_signals must name one or more of execute, repeat both"):
+        TrainConfig(phrasing_signals=("describe",))
+
+
 def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short):
     profile = get_profile("smoke")
     profile.model = replace(profile.model, language_encoder="pretrained")
