@@ -313,7 +313,7 @@ class Playground:
                            layout=w.Layout(width="32em"))
         self.loop = w.Dropdown(options=[("open loop", "open"), ("closed loop (execute)", "closed"), ("no robot", None)],
                                description="robot")
-        self.route = w.Dropdown(options=[("the sentence", "direct"), ("what it said back", "said back")],
+        self.route = w.Dropdown(options=[("what it said back", "said back"), ("the sentence", "direct")],
                                 description="act on")            # free text under execute (PGAE-BERT)
         self.button = w.Button(description="Run", button_style="primary", icon="play")
         self.output = w.Output()

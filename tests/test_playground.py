@@ -205,6 +205,10 @@ def test_pgae_bert_reads_free_text(toy):
     ui.button.click()
     assert ui.result is None and "reads only its vocabulary" in ui.message
     ui.model.value = "PGAE-BERT"
+    assert ui.route.value == "said back"                  # acts on what it said, unless told otherwise
+    ui.button.click()
+    assert ui.message == "" and np.allclose(ui.result.joints, back.joints)
+    ui.route.value = "direct"
     ui.button.click()
     assert ui.message == "" and np.allclose(ui.result.joints, r.joints)
 
