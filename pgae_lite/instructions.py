@@ -57,6 +57,12 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
 ROUTES = ("direct", "said back")
 
 
+def check_route(route: str) -> None:
+    """A ValueError naming the routes unless ``route`` is one of :data:`ROUTES`."""
+    if route not in ROUTES:
+        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
+
+
 @torch.no_grad()
 def say_back(model: PGAE, data: PGAEDataset, normaliser: Normaliser, texts: list[str]) -> list[str]:
     """Each instruction said back in the dataset's words (``repeat language``; sample i of ``data``
@@ -112,8 +118,7 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     features) or ``"said back"`` (:func:`say_back`, then those words; the ``acted_on``
     column).
     """
-    if route not in ROUTES:
-        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
+    check_route(route)
     paraphrases = load_paraphrases() if paraphrases is None else paraphrases
     subset = data.split(split)
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
@@ -135,4 +140,4 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
         for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
 
 
-__all__ = ["ROUTES", "instruction_features", "say_back", "acted_on", "paraphrase_of", "execute_paraphrases"]
+__all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of", "execute_paraphrases"]

@@ -41,7 +41,7 @@ from .closedloop import closed_loop, open_loop, pattern_for
 from .config import PROFILES
 from .data import Normaliser, PGAEDataset, description_text
 from .errors import PGAELiteError
-from .instructions import ROUTES, acted_on
+from .instructions import acted_on, check_route
 from .language import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
     parse_description, tokenize
 from .patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
@@ -224,8 +224,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     pattern_number(arrangement, action)                    # checks both
     instance_of("text", text, str, "a description (a string)", optional=True)
     signal, text = normalise_signal(signal), (text or "").strip()
-    if route not in ROUTES:
-        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
+    check_route(route)
     if loop not in ("open", "closed", None):
         raise ValueError(f"unknown loop {loop!r}; the options are: 'open', 'closed', None")
     if loop == "closed" and (signal != "execute" or cae is None):
