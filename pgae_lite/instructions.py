@@ -58,7 +58,7 @@ ROUTES = ("direct", "said back")
 
 
 def check_route(route: str) -> None:
-    """A ValueError naming the routes unless ``route`` is one of :data:`ROUTES`."""
+    """A ValueError naming the routes unless ``route`` is one of ``ROUTES``."""
     if route not in ROUTES:
         raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
 
