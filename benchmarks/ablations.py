@@ -1,6 +1,6 @@
 """Chapter 04's ablation exercises at the recipe, three seeds: the reference their solutions quote.
 
-    python benchmarks/ablations.py [--ablations concat no-both ...] [--seeds 0 1 2] [--threads 1]
+    python benchmarks/ablations.py [--ablations concat no-both ...] [--seeds 0 1 2] [--threads 1] [--workers 2]
 
 Each ablation changes one thing of the profile's recipe (``book``), exactly as its
 exercise's solution does, and trains PGAE on our simulated data (the
@@ -8,7 +8,8 @@ chapter's data) once per seed; the recipe itself (``recipe``, the cached
 :func:`pgae_lite.pipeline.trained_pgae`) is the baseline, on the same seeds.
 Writes every model's Table 1 cells and training time to
 results/ablations.json, so a solution can say whether its effect exceeds the
-spread of the seeds.
+spread of the seeds. With ``--workers N`` N models train side by side, each in
+its own process on one thread.
 """
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ import copy
 import torch
 from torch import nn
 
-from harness import Benchmark
+from harness import Benchmark, side_by_side
 from pgae_lite import language
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
@@ -87,22 +88,30 @@ def train_ablation(name: str, data, profile_name: str, seed: int):
         language.WORD_WEIGHTS.update(saved)
 
 
+def measure(name: str, seed: int, profile_name: str, threads: int | None) -> dict:
+    """One model (the recipe's or one ablation's) trained on our data and its Table 1 cells."""
+    if threads:
+        torch.set_num_threads(threads)
+    data = simulated_dataset(profile_name, "cpu", progress=False)
+    trained = (trained_pgae("PGAE", profile_name, seed, device="cpu", progress=False) if name == "recipe"
+               else train_ablation(name, data, profile_name, seed))
+    cells, _ = evaluate(trained.model, data, trained.normaliser)
+    print(name, seed, {s: (round(c["accuracy"], 2), round(c["nrmse"], 3)) for s, c in cells.items()},
+          flush=True)
+    return {"ablation": name, "seed": seed, "train_seconds": round(trained.seconds, 1),
+            "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}}
+
+
 def main() -> None:
     bench = Benchmark("ablations", __doc__, seeds=[0, 1, 2])
     bench.parser.add_argument("--ablations", nargs="+", default=list(ABLATIONS), choices=list(ABLATIONS))
+    bench.parser.add_argument("--workers", type=int, default=1,
+                              help="models trained side by side, each in its own process")
     args = bench.parse()
-    data = simulated_dataset(args.profile, "cpu", progress=False)
-    runs = []
-    for name in ["recipe", *args.ablations]:
-        for seed in args.seeds:
-            trained = (trained_pgae("PGAE", args.profile, seed, device="cpu", progress=False) if name == "recipe"
-                       else train_ablation(name, data, args.profile, seed))
-            cells, _ = evaluate(trained.model, data, trained.normaliser)
-            runs.append({"ablation": name, "seed": seed, "train_seconds": round(trained.seconds, 1),
-                         "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}})
-            print(name, seed, {s: (round(c["accuracy"], 2), round(c["nrmse"], 3)) for s, c in cells.items()},
-                  flush=True)
-    bench.write({"data": "ours (simulated)", "runs": runs})
+    simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
+    threads = 1 if args.workers > 1 else args.threads
+    jobs = [(name, seed, args.profile, threads) for name in ["recipe", *args.ablations] for seed in args.seeds]
+    bench.write({"data": "ours (simulated)", "runs": side_by_side(measure, jobs, args.workers)})
 
 
 if __name__ == "__main__":   # recording the data spawns workers, which re-import this file

@@ -46,13 +46,10 @@ import tempfile
 import time
 from pathlib import Path
 
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
-
 import numpy as np
 import torch
 
-from harness import Benchmark
+from harness import Benchmark, side_by_side
 from pgae_lite.closedloop import variation_of
 from pgae_lite.config import TRAININGS, get_profile, training_profile
 from pgae_lite.evaluate import evaluate, predict
@@ -159,14 +156,6 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
     run["measure_seconds"] = round(time.perf_counter() - t0, 1)
     print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1")}, flush=True)
     return run
-
-
-def side_by_side(work, jobs: list[tuple], workers: int) -> list[dict]:
-    """``work(*job)`` for each job, ``workers`` processes at a time (spawned), in the jobs' order."""
-    if workers <= 1:
-        return [work(*job) for job in jobs]
-    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-        return list(pool.map(work, *zip(*jobs)))
 
 
 def main() -> None:

@@ -40,6 +40,8 @@ import shlex
 import subprocess
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -114,3 +116,15 @@ class Benchmark:
         atomic_write_text(path, json.dumps(report, indent=1, allow_nan=False) + "\n")
         print(f"written to {os.path.relpath(path)}")
         return path
+
+
+def side_by_side(work, jobs: list[tuple], workers: int) -> list:
+    """``work(*job)`` for each job, ``workers`` processes at a time (spawned), in the jobs' order.
+
+    ``work`` must be a module-level function of the benchmark (spawned workers import it) and
+    should set its own threads (one per worker: these networks gain nothing from two).
+    """
+    if workers <= 1:
+        return [work(*job) for job in jobs]
+    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+        return list(pool.map(work, *zip(*jobs)))
