@@ -14,6 +14,7 @@ its own process on one thread.
 from __future__ import annotations
 
 import copy
+import functools
 
 import torch
 from torch import nn
@@ -88,11 +89,15 @@ def train_ablation(name: str, data, profile_name: str, seed: int):
         language.WORD_WEIGHTS.update(saved)
 
 
+#: the simulated data, loaded once per process (every job in a worker reads the same)
+dataset = functools.cache(simulated_dataset)
+
+
 def measure(name: str, seed: int, profile_name: str, threads: int | None) -> dict:
     """One model (the recipe's or one ablation's) trained on our data and its Table 1 cells."""
     if threads:
         torch.set_num_threads(threads)
-    data = simulated_dataset(profile_name, "cpu", progress=False)
+    data = dataset(profile_name, "cpu", progress=False)
     trained = (trained_pgae("PGAE", profile_name, seed, device="cpu", progress=False) if name == "recipe"
                else train_ablation(name, data, profile_name, seed))
     cells, _ = evaluate(trained.model, data, trained.normaliser)
@@ -108,7 +113,7 @@ def main() -> None:
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="models trained side by side, each in its own process")
     args = bench.parse()
-    simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
+    dataset(args.profile, "cpu", progress=False)                # recorded once, before the workers start
     threads = 1 if args.workers > 1 else args.threads
     jobs = [(name, seed, args.profile, threads) for name in ["recipe", *args.ablations] for seed in args.seeds]
     bench.write({"data": "ours (simulated)", "runs": side_by_side(measure, jobs, args.workers)})
