@@ -5,8 +5,8 @@ unseen natural language", but trained on the dataset's three-word descriptions
 alone it reads a free-form instruction as something far from anything it was
 trained on. With ``TrainConfig.phrasings`` = K > 0, every sample whose signal
 takes a description (execute, repeat both, repeat language; or those of
-``TrainConfig.phrasing_signals``) reads, with
-probability :data:`PHRASING_PROB`, one of K sentences that say its
+``TrainConfig.phrasing_signals``) reads, with probability
+``TrainConfig.phrasing_prob``, one of K sentences that say its
 description in other words (:func:`pgae_lite.phrasings.phrasings`, a grammar
 and lexicon written for the purpose, independent of the held-out test
 sentences) instead of the description itself. The targets stay the dataset's
@@ -28,10 +28,6 @@ from .pretrained import PretrainedLanguageEncoder, input_text
 from .signals import LANG_IN, SignalBatch
 from .utils import cache_dir, config_digest, load_torch, save_torch
 
-#: Chance that a sample with a description reads a phrasing instead (else the description).
-#: Chosen on generated validation sentences (experiments/validation_readback.py), never on the
-#: test paraphrases: 0.75 read back more of them than 0.5, with Table 1 unchanged.
-PHRASING_PROB = 0.75
 MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
 TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, repeat both, repeat language
 
@@ -40,12 +36,13 @@ class PhrasingBank:
     """Sentence vectors of K phrasings per (signal, meaning): a tensor (3, 36, K, D)."""
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
-                 lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None):
+                 lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
+                 prob: float = 0.75):
         if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
                              f"{type(encoder).__name__}")
-        self.per_meaning, self.encoder = per_meaning, encoder
+        self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
         self.texts = [input_text(SIGNALS[s], text) for s in TEXT_SIGNALS for m in MEANINGS
                       for text in phrasings(*m, per_meaning, seed=seed, lexicon=lexicon)]
         shape = (len(TEXT_SIGNALS), len(MEANINGS), per_meaning)
@@ -87,7 +84,7 @@ class PhrasingBank:
         base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
         size = len(batch.signal)
         row = self.signal_row[batch.signal.cpu()]                            # (B,), -1: no description
-        takes = (row >= 0) & (torch.rand(size, generator=generator) < PHRASING_PROB)
+        takes = (row >= 0) & (torch.rand(size, generator=generator) < self.prob)
         which = torch.randint(self.per_meaning, (size,), generator=generator)
         if not takes.any():
             return base

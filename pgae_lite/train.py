@@ -186,7 +186,7 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
         from .phrase_lexicon import training_lexicon
         from .phrasing_bank import PhrasingBank
         bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words),
-                            cfg.phrasing_signals)
+                            cfg.phrasing_signals, cfg.phrasing_prob)
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:

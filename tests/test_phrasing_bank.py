@@ -59,7 +59,7 @@ def test_features_swap_only_samples_with_a_description(bert, toy_tensors):
     changed = (out != base).any(1)
     takes_text = torch.tensor([s in TEXT_SIGNALS for s in signal.tolist()])
     assert not changed[~takes_text].any()                     # describe, repeat action: untouched
-    assert 0 < changed[takes_text].float().mean() < 1         # about half of the others
+    assert 0 < changed[takes_text].float().mean() < 1         # about three in four of the others
 
 
 def test_phrasing_signals_choose_which_samples_read_phrasings(bert, toy_tensors):
@@ -91,3 +91,18 @@ def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short
         TrainConfig(phrasings=-1)
     with pytest.raises(ValueError, match="phrasing_words must be 'all' or 'held-out'; got 'some'"):
         TrainConfig(phrasing_words="some")
+
+
+def test_phrasing_prob_sets_how_often_a_description_reads_a_phrasing(bert, toy_tensors):
+    index = torch.arange(40)
+    signal = torch.full((40,), SIGNALS.index("execute"))
+    batch = make_batch(toy_tensors, index, signal, index % 8)
+    base = bert.language_encoder(batch.lang_tokens, batch.lang_lengths)
+    always = PhrasingBank(bert.language_encoder, 3, prob=1.0)
+    assert (always.features(bert, batch, torch.Generator().manual_seed(0)) != base).any(1).all()
+    assert "phrasing_prob" not in get_profile("book").to_dict()["train"]       # default: the keys of before
+    other = get_profile("book", phrasing_prob=0.5)
+    assert other.to_dict()["train"]["phrasing_prob"] == 0.5                    # another value: another model
+    for bad in (0, 1.5, "0.5", True):
+        with pytest.raises(ValueError, match="phrasing_prob must be a number in"):
+            TrainConfig(phrasing_prob=bad)
