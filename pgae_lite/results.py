@@ -126,6 +126,53 @@ def headline_table() -> str:
     return "\n".join(lines)
 
 
+#: the Table 1 cells an ablation is judged on, (signal, measure): all but the accuracies of execute and
+#: repeat action, which only say that the model wrote <EOS> (100% in every run)
+ABLATION_CELLS = (("describe", "accuracy"), ("repeat language", "accuracy"), ("describe", "nrmse"),
+                  ("repeat language", "nrmse"), ("execute", "nrmse"), ("repeat action", "nrmse"))
+
+
+def ablation_frame(ablation: str, name: str = "ablations") -> pd.DataFrame:
+    """One of chapter 04's ablations against the recipe, from a ``benchmarks/ablations.py`` result.
+
+    Per Table 1 cell: the recipe's and the ablation's median over the seeds with their range
+    (min-max), and whether the two ranges are apart, i.e. whether the effect exceeds the
+    spread of the seeds ("yes, better" / "yes, worse" / "no").
+    """
+    runs = value(name, "runs")
+    there = sorted({r["ablation"] for r in runs} - {"recipe"})
+    if ablation not in there:
+        raise KeyError(f"{name}.json has no ablation {ablation!r}; it has: {', '.join(there)}")
+
+    def per_seed(who: str, signal: str, key: str) -> list[float]:
+        return sorted(r["table1"][signal][key] for r in runs if r["ablation"] == who)
+
+    def text(values: list[float], digits: int) -> str:
+        return f"{pd.Series(values).median():.{digits}f} ({values[0]:.{digits}f}-{values[-1]:.{digits}f})"
+
+    rows = {}
+    for signal, key in ABLATION_CELLS:
+        base, changed = per_seed("recipe", signal, key), per_seed(ablation, signal, key)
+        digits = 2 if key == "accuracy" else 3
+        higher = pd.Series(changed).median() > pd.Series(base).median()
+        better = higher if key == "accuracy" else not higher
+        apart = changed[0] > base[-1] or changed[-1] < base[0]
+        rows[f"{signal} {'accuracy' if key == 'accuracy' else 'nRMSE'} %"] = {
+            f"recipe ({len(base)} seeds)": text(base, digits),
+            f"{ablation} ({len(changed)} seeds)": text(changed, digits),
+            "beyond the seeds' spread": ("yes, better" if better else "yes, worse") if apart else "no"}
+    return pd.DataFrame(rows).T
+
+
+def ablation_verdict(frame: pd.DataFrame) -> str:
+    """In one sentence: which cells of an :func:`ablation_frame` differ beyond the spread of the seeds."""
+    verdicts = frame["beyond the seeds' spread"]
+    apart = [f"{cell.removesuffix(' %')} ({v.removeprefix('yes, ')})" for cell, v in verdicts.items() if v != "no"]
+    if not apart:
+        return "no cell of Table 1 differs from the recipe's by more than the spread of the seeds"
+    return "beyond the spread of the seeds: " + ", ".join(apart)
+
+
 README_START, README_END = "<!-- headline:start", "<!-- headline:end -->"
 
 

@@ -72,3 +72,39 @@ def test_a_missing_result_file_is_a_clear_error(tmp_path, monkeypatch):
     monkeypatch.setenv(results.RESULTS_ENV, str(tmp_path))
     with pytest.raises(FileNotFoundError, match="the result files are: none"):
         results.load("table1-original")
+
+
+def write_ablations(folder: Path, recipe: list[float], changed: list[float]) -> None:
+    """A minimal ablations result: describe accuracy per seed for the recipe and "concat"."""
+    def cells(describe):
+        return {"describe": {"accuracy": describe, "nrmse": 0.1}, "repeat language": {"accuracy": 100.0, "nrmse": 0.1},
+                "execute": {"accuracy": 100.0, "nrmse": 0.4}, "repeat action": {"accuracy": 100.0, "nrmse": 0.4}}
+    runs = [{"ablation": who, "seed": seed, "table1": cells(d)}
+            for who, values in (("recipe", recipe), ("concat", changed)) for seed, d in enumerate(values)]
+    (folder / "ablations.json").write_text(json.dumps({"data": {"runs": runs}}))
+
+
+def test_an_ablation_is_judged_against_the_spread_of_the_seeds(tmp_path, monkeypatch):
+    monkeypatch.setenv(results.RESULTS_ENV, str(tmp_path))
+    write_ablations(tmp_path, recipe=[90.0, 94.0, 99.0], changed=[80.0, 85.0, 89.0])
+    frame = results.ablation_frame("concat")
+    assert frame.loc["describe accuracy %", "recipe (3 seeds)"] == "94.00 (90.00-99.00)"
+    assert frame.loc["describe accuracy %", "beyond the seeds' spread"] == "yes, worse"
+    assert frame.loc["execute nRMSE %", "beyond the seeds' spread"] == "no"
+    assert results.ablation_verdict(frame) == "beyond the spread of the seeds: describe accuracy (worse)"
+    write_ablations(tmp_path, recipe=[90.0, 94.0, 99.0], changed=[85.0, 91.0, 95.0])   # ranges overlap
+    assert results.ablation_verdict(results.ablation_frame("concat")).startswith("no cell of Table 1 differs")
+    with pytest.raises(KeyError, match="no ablation 'cells'; it has: concat"):
+        results.ablation_frame("cells")
+
+
+ABLATION_CALL = re.compile(r"ablation_frame\(\s*[\"']([\w-]+)[\"'](?:,\s*(?:name=)?[\"']([\w-]+)[\"'])?")
+
+
+def test_every_ablation_a_chapter_quotes_is_in_its_result_file():
+    calls = [c for p in sorted((ROOT / "notebooks").glob("*.ipynb"))
+             for cell in json.loads(p.read_text())["cells"] if cell["cell_type"] == "code"
+             for c in ABLATION_CALL.findall("".join(cell["source"]))]
+    assert calls, "no chapter quotes the ablations"
+    for ablation, name in calls:
+        results.ablation_frame(ablation, name or "ablations")      # KeyError/FileNotFoundError if not
