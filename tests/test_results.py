@@ -37,15 +37,17 @@ def test_the_readme_headline_table_is_the_one_the_result_file_gives():
         "run `python -m pgae_lite.results --readme`")
 
 
+def code_of(path: Path) -> str:
+    """A notebook's code cells joined (a Markdown file: its text)."""
+    if path.suffix != ".ipynb":
+        return path.read_text()
+    return "\n".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"] if c["cell_type"] == "code")
+
+
 def quotes_in(path: Path) -> list[tuple[str, ...]]:
     """The (name, key, ...) of every results.quote/value call in a notebook's code or a Markdown file."""
-    if path.suffix == ".ipynb":
-        text = "\n".join("".join(c["source"]) for c in json.loads(path.read_text())["cells"]
-                         if c["cell_type"] == "code")
-    else:
-        text = path.read_text()
     found = []
-    for args in QUOTE.findall(text):
+    for args in QUOTE.findall(code_of(path)):
         keys = re.findall(r"[\"']([^\"']+)[\"']|(?<![\w.])(\d+)(?![\w.])", args.split("digits")[0])
         found.append(tuple(a or int(b) for a, b in keys))
     return found
@@ -102,9 +104,7 @@ ABLATION_CALL = re.compile(r"ablation_frame\(\s*[\"']([\w-]+)[\"'](?:,\s*(?:name
 
 
 def test_every_ablation_a_chapter_quotes_is_in_its_result_file():
-    calls = [c for p in sorted((ROOT / "notebooks").glob("*.ipynb"))
-             for cell in json.loads(p.read_text())["cells"] if cell["cell_type"] == "code"
-             for c in ABLATION_CALL.findall("".join(cell["source"]))]
+    calls = [c for p in sorted((ROOT / "notebooks").glob("*.ipynb")) for c in ABLATION_CALL.findall(code_of(p))]
     assert calls, "no chapter quotes the ablations"
     for ablation, name in calls:
         results.ablation_frame(ablation, name or "ablations")      # KeyError/FileNotFoundError if not
