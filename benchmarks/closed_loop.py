@@ -1,7 +1,8 @@
 """Open vs closed loop in the simulator: does the robot do what it was told?
 
     python benchmarks/closed_loop.py [--trainings PGAE PGAE-BERT] [--seeds 0 1 2] [--profile book]
-                                     [--limit 24] [--no-tracking] [--threads 1]
+                                     [--limit 24] [--no-tracking] [--threads 1] [--workers 3]
+                                     [--set plan_weight=1 epochs=200]
 
 For each training and seed, the profile's recipe model on our simulated data
 (:func:`pgae_lite.pipeline.trained_pgae`: trained once, then cached) executes
@@ -14,19 +15,68 @@ cells on the same data (:func:`pgae_lite.evaluate.evaluate`) and whether its h s
 which cube to move (:func:`pgae_lite.plan.which_cube_probe`; ``PGAE-no-plan`` is the
 recipe without the plan head). ``--limit N`` takes N
 episodes evenly spread over the 216 of the test split. The models are small:
-one thread is as fast as two.
+one thread is as fast as two, so ``--workers N`` trains and runs N models side by
+side, one process and one thread each. ``--set KEY=VALUE ...`` measures a candidate
+recipe: those training options (:class:`pgae_lite.config.TrainConfig`) changed from
+the profile's, for every training; the models are cached under their own names.
 """
 from __future__ import annotations
 
+import argparse
+import json
 import statistics
 import time
 
-from harness import Benchmark
+import torch
+
+from harness import Benchmark, side_by_side
 from pgae_lite.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
+from pgae_lite.errors import ArgumentError
 from pgae_lite.evaluate import evaluate
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.plan import which_cube_probe
+
+
+def option(text: str) -> tuple[str, object]:
+    """``--set`` KEY=VALUE: a training option and its value (JSON where it parses, else the text)."""
+    key, sep, raw = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (a TrainConfig option), got {text!r}")
+    try:
+        return key, json.loads(raw)
+    except json.JSONDecodeError:
+        return key, raw
+
+
+def measure(training: str, seed: int, profile: str, threads: int | None, limit: int | None,
+            tracking: bool, overrides: dict) -> dict:
+    """One model (trained once, then cached) in open and closed loop, with its Table 1 cells."""
+    if threads:
+        torch.set_num_threads(threads)
+    cae, _ = trained_cae(profile, "cpu", progress=False)
+    data = simulated_dataset(profile, "cpu", progress=False)
+    trained = trained_pgae(training, profile, seed, device="cpu", progress=False, **overrides)
+    t0 = time.perf_counter()
+    table = compare(trained.model, cae, trained.normaliser, data, limit=limit,
+                    config=get_profile(profile).data, tracking=tracking)
+    seconds = time.perf_counter() - t0
+    summary = success_summary(table)
+    open_, closed = 100 * table["open_passed"].mean(), 100 * table["closed_passed"].mean()
+    print(f"\n== {training}, seed {seed}: open loop {open_:.1f}%, closed loop {closed:.1f}% "
+          f"({len(table)} episodes, {seconds / len(table):.2f} s each)\n{summary.round(2).to_string()}",
+          flush=True)
+    failed = table[~table["closed_passed"]]
+    cells, _ = evaluate(trained.model, data, trained.normaliser)
+    return {"training": training, "seed": seed, "episodes": len(table),
+            "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
+            "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
+            "seconds_per_episode": round(seconds / len(table), 3),
+            "which_cube_probe_%": round(which_cube_probe(trained.model, data, trained.normaliser), 2),
+            "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
+            "summary": summary.reset_index().round(2).to_dict(orient="records"),
+            "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
+            .to_dict(orient="records")}
 
 
 def main() -> None:
@@ -35,34 +85,21 @@ def main() -> None:
     bench.parser.add_argument("--limit", type=int, default=None, help="this many test episodes, evenly spread")
     bench.parser.add_argument("--no-tracking", action="store_true",
                               help="send the model's joints to the motors as they are")
+    bench.parser.add_argument("--set", nargs="+", type=option, default=[], metavar="KEY=VALUE",
+                              help="training options changed from the recipe (a candidate recipe)")
+    bench.parser.add_argument("--workers", type=int, default=1,
+                              help="models trained and run side by side, each in its own process")
     args = bench.parse()
-
-    cae, _ = trained_cae(args.profile, "cpu", progress=False)
-    data = simulated_dataset(args.profile, "cpu", progress=False)
-    runs = []
-    for training in args.trainings:
-        for seed in args.seeds:
-            trained = trained_pgae(training, args.profile, seed, device="cpu", progress=False)
-            t0 = time.perf_counter()
-            table = compare(trained.model, cae, trained.normaliser, data, limit=args.limit,
-                            config=get_profile(args.profile).data, tracking=not args.no_tracking)
-            seconds = time.perf_counter() - t0
-            summary = success_summary(table)
-            open_, closed = 100 * table["open_passed"].mean(), 100 * table["closed_passed"].mean()
-            print(f"\n== {training}, seed {seed}: open loop {open_:.1f}%, closed loop {closed:.1f}% "
-                  f"({len(table)} episodes, {seconds / len(table):.2f} s each)")
-            print(summary.round(2).to_string())
-            failed = table[~table["closed_passed"]]
-            cells, _ = evaluate(trained.model, data, trained.normaliser)
-            runs.append({"training": training, "seed": seed, "episodes": len(table),
-                         "open_success_%": round(open_, 2), "closed_success_%": round(closed, 2),
-                         "gap_points": round(open_ - closed, 2), "train_seconds": round(trained.seconds, 1),
-                         "seconds_per_episode": round(seconds / len(table), 3),
-                         "which_cube_probe_%": round(which_cube_probe(trained.model, data, trained.normaliser), 2),
-                         "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()},
-                         "summary": summary.reset_index().round(2).to_dict(orient="records"),
-                         "closed_failures": failed[["id", "description", "open_passed", "closed_reason"]]
-                         .to_dict(orient="records")})
+    overrides = dict(args.set)
+    try:
+        get_profile(args.profile, **overrides)                 # an unknown option fails here, at once
+    except ArgumentError as e:
+        bench.parser.error(str(e))
+    trained_cae(args.profile, "cpu", progress=False)           # data and CAE made once, before the workers
+    threads = 1 if args.workers > 1 else args.threads
+    jobs = [(training, seed, args.profile, threads, args.limit, not args.no_tracking, overrides)
+            for training in args.trainings for seed in args.seeds]
+    runs = side_by_side(measure, jobs, args.workers)
     trainings = {}
     for training in args.trainings:            # over seeds: what the book quotes
         mine = [r for r in runs if r["training"] == training]
@@ -80,7 +117,8 @@ def main() -> None:
             "describe_median_%": statistics.median(r["table1"]["describe"]["accuracy"] for r in mine)}
         print(f"{training}: closed loop median {trainings[training]['closed_median_%']:.2f}%, "
               f"worst seed {trainings[training]['closed_min_%']:.2f}%")
-    bench.write({"limit": args.limit, "tracking": not args.no_tracking, "trainings": trainings, "runs": runs})
+    bench.write({"limit": args.limit, "tracking": not args.no_tracking, "overrides": overrides,
+                 "trainings": trainings, "runs": runs})
 
 
 if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
