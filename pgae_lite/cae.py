@@ -36,7 +36,7 @@ from torch import nn
 from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
-from .utils import CheckpointMismatchError, default_device, load_torch, save_torch
+from .utils import CheckpointMismatchError, default_device, load_torch, save_torch, training_threads
 
 HEIGHT, WIDTH = 120, 160
 COLOURS = ("red", "green", "blue")
@@ -225,8 +225,9 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
     """Train a :class:`ChannelSeparatedCAE` on ``images`` (N, 120, 160, 3) uint8.
 
     Batches are drawn without replacement from a seeded shuffle (a new one each
-    pass over the data), so a seed gives the same weights bit for bit on the same
-    device with the same number of torch threads. History: one record per
+    pass over the data), and on the CPU it runs on a fixed number of torch threads
+    (:func:`~pgae_lite.utils.training_threads`), so a seed gives the same weights bit for
+    bit on the same kind of device, whatever the caller's thread count. History: one record per
     iteration, ``{"iteration", "loss", "red", "green", "blue"}`` (BCE).
 
     With ``out_path`` the finished model is written there atomically; if that
@@ -257,7 +258,8 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
     model.train()
     # On CUDA, cuDNN may pick convolution kernels that add in a varying order: ask for
     # deterministic ones, so that a seed gives the same weights there too (no effect on the CPU).
-    with torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True):
+    # On the CPU, a fixed number of threads (utils.training_threads): the same weights on any machine.
+    with torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True), training_threads(device):
         history = _train_loop(model, optimiser, images, config, rng, progress)
     model.eval()
     if out_path is not None:                 # atomic: a crash never leaves half a file

@@ -5,8 +5,9 @@
 The word weights counter word frequency (``<BOS/EOS>`` is in every
 description, a colour word in one of six); both terms are averaged over the
 valid steps only. Training is deterministic under a seed (bit for bit on the
-same device with the same number of torch threads: a 1-thread and a 2-thread
-CPU run round sums differently and drift apart), runs on CUDA when present
+same kind of device: on the CPU it runs on a fixed number of torch threads,
+:func:`~pgae_lite.utils.training_threads`, since a 1-thread and a 2-thread run
+round sums differently and drift apart), runs on CUDA when present
 (else the CPU), and resumes from its last checkpoint after an interruption.
 """
 from __future__ import annotations
@@ -29,7 +30,7 @@ from .pgae import PGAE
 from .plan import plan_loss, plan_targets
 from .signals import EXECUTE, SignalBatch, make_batch, sample_signals
 from .utils import (CheckpointMismatchError, default_device, folder_lock, load_torch,
-                    save_torch)
+                    save_torch, training_threads)
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.
@@ -132,10 +133,11 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     """
     device = torch.device(device) if device else default_device()
     args = (dataset, profile, out_dir, device, progress, model, callback)
-    if out_dir is None:
-        return _train(*args)
-    with folder_lock(out_dir):
-        return _train(*args)
+    with training_threads(device):   # on the CPU a fixed thread count: the same model on any machine
+        if out_dir is None:
+            return _train(*args)
+        with folder_lock(out_dir):
+            return _train(*args)
 
 
 def _train(dataset: PGAEDataset, profile: Profile | str | None,

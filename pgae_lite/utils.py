@@ -5,6 +5,8 @@ What several modules need and none of them owns. It imports nothing from
 
 - :func:`cache_dir`: the root of every cache (``$PGAE_LITE_CACHE``);
 - :func:`default_device`: CUDA when present, else the CPU;
+- :func:`training_threads`: a training on the CPU runs on a fixed number of torch
+  threads, so that a seed gives the same model on any machine;
 - :func:`atomic_path`, :func:`atomic_write`, :func:`atomic_write_text`: a file
   is written under a temporary name beside its place, then renamed onto it in
   one step, so a reader (or a crash) never meets half a file;
@@ -63,6 +65,29 @@ def cache_dir() -> Path:
 def default_device() -> torch.device:
     """CUDA when present, else the CPU."""
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+#: Torch threads of every training on the CPU (the CAE's and PGAE's), whatever the caller set.
+#: A parallel sum adds in an order that depends on the thread count, and a training amplifies
+#: the last bits: a CAE trained on 1 and on 2 threads ends with other weights, so other visual
+#: features and other PGAE models. One fixed count makes the data and the models the same on
+#: every machine (tests/test_utils.py); these small networks train as fast on one thread as on two.
+TRAINING_THREADS = 1
+
+
+@contextlib.contextmanager
+def training_threads(device: torch.device | str) -> Iterator[None]:
+    """Run the block on :data:`TRAINING_THREADS` torch threads when ``device`` is the CPU
+    (the caller's count is restored after); on a GPU nothing changes."""
+    if torch.device(device).type != "cpu":
+        yield
+        return
+    before = torch.get_num_threads()
+    torch.set_num_threads(TRAINING_THREADS)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(before)
 
 
 def config_digest(obj) -> str:
@@ -263,4 +288,5 @@ def folder_lock(folder: str | Path) -> Iterator[None]:
 __all__ = ["CACHE_ENV", "CheckpointMismatchError", "CorruptCheckpointError",
            "FolderBusyError", "OutputError", "array_digest", "atomic_path",
            "atomic_write", "atomic_write_text", "cache_dir", "config_digest",
-           "default_device", "folder_lock", "load_torch", "make_folder", "save_torch"]
+           "default_device", "folder_lock", "load_torch", "make_folder", "save_torch",
+           "training_threads", "TRAINING_THREADS"]

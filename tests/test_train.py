@@ -83,6 +83,21 @@ def test_same_seed_same_run_different_seed_different_run(toy_short):
     assert not _same_weights(_weights(a.model), _weights(c.model))
 
 
+def test_the_callers_thread_count_does_not_change_the_model(toy_short):
+    """A training runs on utils.TRAINING_THREADS, whatever the caller set, and gives it back."""
+    before = torch.get_num_threads()
+    runs = []
+    try:
+        for threads in (1, 2):          # the book's sizes: big enough for torch to split its sums
+            torch.set_num_threads(threads)
+            runs.append(train(toy_short, tiny_profile(units=100, epochs=2), progress=False, device="cpu"))
+            assert torch.get_num_threads() == threads
+    finally:
+        torch.set_num_threads(before)
+    assert runs[0].history == runs[1].history
+    assert _same_weights(_weights(runs[0].model), _weights(runs[1].model))
+
+
 # --------------------------------------------------------------------------- checkpoints
 def test_checkpoint_round_trip(toy_short, tmp_path):
     prof = tiny_profile(epochs=2)
