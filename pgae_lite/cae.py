@@ -259,7 +259,8 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
     # On CUDA, cuDNN may pick convolution kernels that add in a varying order: ask for
     # deterministic ones, so that a seed gives the same weights there too (no effect on the CPU).
     # On the CPU, a fixed number of threads (utils.training_threads): the same weights on any machine.
-    with torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True), training_threads(device):
+    deterministic = torch.backends.cudnn.flags(enabled=True, benchmark=False, deterministic=True)
+    with deterministic, training_threads(device):
         history = _train_loop(model, optimiser, images, config, rng, progress)
     model.eval()
     if out_path is not None:                 # atomic: a crash never leaves half a file

@@ -71,7 +71,8 @@ def default_device() -> torch.device:
 #: A parallel sum adds in an order that depends on the thread count, and a training amplifies
 #: the last bits: a CAE trained on 1 and on 2 threads ends with other weights, so other visual
 #: features and other PGAE models. One fixed count makes the data and the models the same on
-#: every machine (tests/test_utils.py); these small networks train as fast on one thread as on two.
+#: every machine (tests/test_cae.py, tests/test_train.py). PGAE trains as fast on one thread as
+#: on two; the CAE's convolutions are slower on one, once per cache (the book's results page, A2).
 TRAINING_THREADS = 1
 
 
