@@ -23,6 +23,7 @@ the profile's, for every training; the models are cached under their own names.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import statistics
 import time
@@ -49,13 +50,18 @@ def option(text: str) -> tuple[str, object]:
         return key, raw
 
 
+@functools.cache
+def cae_and_data(profile: str):
+    """The profile's CAE and simulated data, loaded once per process (every job in a worker reads the same)."""
+    return trained_cae(profile, "cpu", progress=False)[0], simulated_dataset(profile, "cpu", progress=False)
+
+
 def measure(training: str, seed: int, profile: str, threads: int | None, limit: int | None,
             tracking: bool, overrides: dict) -> dict:
     """One model (trained once, then cached) in open and closed loop, with its Table 1 cells."""
     if threads:
         torch.set_num_threads(threads)
-    cae, _ = trained_cae(profile, "cpu", progress=False)
-    data = simulated_dataset(profile, "cpu", progress=False)
+    cae, data = cae_and_data(profile)
     trained = trained_pgae(training, profile, seed, device="cpu", progress=False, **overrides)
     t0 = time.perf_counter()
     table = compare(trained.model, cae, trained.normaliser, data, limit=limit,
@@ -95,7 +101,7 @@ def main() -> None:
         get_profile(args.profile, **overrides)                 # an unknown option fails here, at once
     except ArgumentError as e:
         bench.parser.error(str(e))
-    trained_cae(args.profile, "cpu", progress=False)           # data and CAE made once, before the workers
+    cae_and_data(args.profile)                                 # data and CAE made once, before the workers
     threads = 1 if args.workers > 1 else args.threads
     jobs = [(training, seed, args.profile, threads, args.limit, not args.no_tracking, overrides)
             for training in args.trainings for seed in args.seeds]

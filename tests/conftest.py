@@ -1,4 +1,4 @@
-"""Shared fixtures: a tiny synthetic dataset and, when present, the authors' data.
+"""Shared fixtures: a tiny synthetic dataset, when present the authors' data, and torch's threads.
 
 The authors' data (public repository oo222bs/PGAE, the folder holding
 ``target/``) is looked for in ``$PGAE_ORIGINAL_DATA``, else in
@@ -100,3 +100,11 @@ def smoke_episodes(_private_cache):
 def _seed():
     """Every test starts from the same global torch seed."""
     torch.manual_seed(0)
+
+
+@pytest.fixture
+def set_threads():
+    """``set_threads(n)`` sets torch's thread count for the test; the count before is restored after it."""
+    before = torch.get_num_threads()
+    yield torch.set_num_threads
+    torch.set_num_threads(before)

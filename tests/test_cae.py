@@ -118,20 +118,16 @@ def test_training_is_deterministic(images):
     assert not torch.equal(a.red.fc[0].weight, c.red.fc[0].weight)
 
 
-def test_the_callers_thread_count_does_not_change_the_weights(images):
+def test_the_callers_thread_count_does_not_change_the_weights(images, set_threads):
     """Trained on 1 and on 2 torch threads, a CAE is the same (utils.training_threads); without the
     fixed count the convolutions' sums add in other orders and the weights differ after a few steps."""
     config = CAEConfig("tiny", batch_size=32, iterations=4, seed=0)
-    before = torch.get_num_threads()
     weights = []
-    try:
-        for threads in (1, 2):
-            torch.set_num_threads(threads)
-            model, _ = train_cae(images, config, device="cpu", progress=False)
-            weights.append(model.state_dict())
-            assert torch.get_num_threads() == threads          # the caller's count is back
-    finally:
-        torch.set_num_threads(before)
+    for threads in (1, 2):
+        set_threads(threads)
+        model, _ = train_cae(images, config, device="cpu", progress=False)
+        weights.append(model.state_dict())
+        assert torch.get_num_threads() == threads          # the caller's count is back
     for name, p in weights[0].items():
         assert torch.equal(p, weights[1][name]), name
 

@@ -83,17 +83,13 @@ def test_same_seed_same_run_different_seed_different_run(toy_short):
     assert not _same_weights(_weights(a.model), _weights(c.model))
 
 
-def test_the_callers_thread_count_does_not_change_the_model(toy_short):
+def test_the_callers_thread_count_does_not_change_the_model(toy_short, set_threads):
     """A training runs on utils.TRAINING_THREADS, whatever the caller set, and gives it back."""
-    before = torch.get_num_threads()
     runs = []
-    try:
-        for threads in (1, 2):          # the book's sizes: big enough for torch to split its sums
-            torch.set_num_threads(threads)
-            runs.append(train(toy_short, tiny_profile(units=100, epochs=2), progress=False, device="cpu"))
-            assert torch.get_num_threads() == threads
-    finally:
-        torch.set_num_threads(before)
+    for threads in (1, 2):              # the book's sizes: big enough for torch to split its sums
+        set_threads(threads)
+        runs.append(train(toy_short, tiny_profile(units=100, epochs=2), progress=False, device="cpu"))
+        assert torch.get_num_threads() == threads
     assert runs[0].history == runs[1].history
     assert _same_weights(_weights(runs[0].model), _weights(runs[1].model))
 
