@@ -3,6 +3,8 @@
     python experiments/explore_recipe.py --epochs 300 --seed 0 [--sim] [--set key=value ...] [--model key=value ...]
 
 On the authors' data by default; ``--sim`` uses the book profile's simulated data.
+``--opposite`` also scores the opposite agent's view (PGAE-opposite; cells prefixed ``opp_``),
+for the two-view model (``--set opposite_prob=0.5``).
 """
 import argparse, json, time
 from pathlib import Path
@@ -31,6 +33,7 @@ def main() -> None:
     ap.add_argument("--set", nargs="*", default=[], help="TrainConfig overrides key=value")
     ap.add_argument("--model", nargs="*", default=[], help="ModelConfig overrides key=value")
     ap.add_argument("--sim", action="store_true", help="the simulated data (book profile) instead of the authors'")
+    ap.add_argument("--opposite", action="store_true", help="also score the opposite view (opp_ cells)")
     ap.add_argument("--log", default=None)
     ap.add_argument("--save", default=None, help="folder for the checkpoint (default: none saved)")
     a = ap.parse_args()
@@ -52,6 +55,10 @@ def main() -> None:
         line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
                 **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
                 "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}
+        if a.opposite:
+            opp, _ = evaluate(model, ds, norm, opposite=True)
+            line["opp_describe"] = round(opp["describe"]["accuracy"], 2)
+            line["opp_repeat_a_e"] = round(opp["repeat action"]["nrmse"], 3)
         rows.append(line)
         print(json.dumps(line), flush=True)
 
