@@ -7,7 +7,7 @@ do: it is open-loop. Here the model's own motion makes the images it reads::
 
     frame_0 = NICO at its start pose                      (as every recording starts)
     h       = encode(signal execute + description, [v_0; j_0])
-    for t = 0, k, 2k, ... < T-1:                          (k = the model's time_stride, 2 in the book)
+    for t = 0, k, 2k, ... < T-1:                          (k = the model's time_stride, 3 in the book)
         ĵ_{t+1} .. ĵ_{t+k} = decoder.step(v_t, ĵ_t)        (ĵ_0 = j_0)
         for each s = t+1 .. t+k: move the arm so that its joints reach ĵ_s;
             step the physics; render frame_s

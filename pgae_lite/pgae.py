@@ -11,10 +11,10 @@ Two autoencoders, language and action, joined in a GMU bottleneck:
 Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50,
 30 visual features and 5 joints per step.
 
-Deviation from paper: with ``time_stride`` k (2 in the book) one step of the
+Deviation from paper: with ``time_stride`` k (3 in the book) one step of the
 action LSTMs covers k time steps: the encoder reads every k-th step, x_0, x_k,
 ...; the decoder reads v_t and writes [ĵ_{t+1}; ...; ĵ_{t+k}], every pose.
-Half the LSTM steps.
+1/k of the LSTM steps.
 
 ``PGAE(cfg, lexicon=...)`` builds the model for a larger vocabulary (not from
 the paper: :func:`pgae_lite.world.with_colour`); the default is the paper's 23 words.

@@ -46,11 +46,11 @@ def test_fused_parameter_count():
     """nn.LSTM has two bias vectors and no peepholes: 4·H extra − 3·H per layer."""
     per_layer = 100                                                # 4H − 3H
     assert count_parameters(PGAE(ModelConfig(time_stride=1, plan_keyframes=0))) == 657_778 + 4 * 2 * per_layer
-    # time_stride 2: the decoder writes 5 more joints per step
-    stride2 = 5 * (100 + 1)
+    # time_stride 3: the decoder writes 2 x 5 more joints per step
+    stride3 = 2 * 5 * (100 + 1)
     # the plan head (book recipe): h (50) -> 100 -> 10 keyframes x 5 joints
     plan = (50 + 1) * 100 + (100 + 1) * 50
-    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer + stride2 + plan
+    assert count_parameters(PGAE(ModelConfig())) == 657_778 + 4 * 2 * per_layer + stride3 + plan
 
 
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
