@@ -24,6 +24,7 @@ from .language import CANONICAL, SIGNALS, SLOTS, VOCABULARY
 from .phrase_lexicon import PhraseLexicon
 from .phrasings import phrasings
 from .attention_pooling import AttentivePretrainedEncoder, cached_token_vectors
+from .config import TrainConfig
 from .pretrained import PretrainedLanguageEncoder, input_text
 from .signals import LANG_IN, SignalBatch
 from .utils import cache_dir, config_digest, load_torch, save_torch
@@ -37,7 +38,7 @@ class PhrasingBank:
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
                  lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
-                 prob: float = 0.75):
+                 prob: float = TrainConfig.phrasing_prob):
         if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
