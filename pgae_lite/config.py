@@ -58,8 +58,9 @@ class ModelConfig:
     joint_feedback: str = "start"
     # Deviation from paper: one step of the action LSTMs covers 3 time steps: the encoder reads every 3rd
     # step, the decoder reads every 3rd frame and writes the next 3 poses, every pose (paper: 1). A third of
-    # the LSTM steps per sample. Stride 2 -> 3 cut an epoch by a tenth (results/epoch_time.json) with the
-    # Table 1 cells unchanged; stride 4 lost joint precision (A2, the recipe's history).
+    # the LSTM steps per sample. Stride 2 -> 3 cut an epoch by a tenth (results/epoch_time.json), and every
+    # Table 1 median stayed at or better than the paper's (results/table1-original.json); stride 4 lost joint
+    # precision (A2, the recipe's history, compares them).
     time_stride: int = 3
     # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (pretrained.py);
     # "pretrained-attention" = the same transformer with a trained attention pooling (attention_pooling.py).
