@@ -22,32 +22,19 @@ the profile's, for every training; the models are cached under their own names.
 """
 from __future__ import annotations
 
-import argparse
 import functools
-import json
 import statistics
 import time
 
 import torch
 
-from harness import Benchmark, side_by_side
+from harness import Benchmark, key_value, side_by_side
 from pgae_lite.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
 from pgae_lite.errors import ArgumentError
 from pgae_lite.evaluate import evaluate
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.plan import which_cube_probe
-
-
-def option(text: str) -> tuple[str, object]:
-    """``--set`` KEY=VALUE: a training option and its value (JSON where it parses, else the text)."""
-    key, sep, raw = text.partition("=")
-    if not sep or not key:
-        raise argparse.ArgumentTypeError(f"expected KEY=VALUE (a TrainConfig option), got {text!r}")
-    try:
-        return key, json.loads(raw)
-    except json.JSONDecodeError:
-        return key, raw
 
 
 @functools.cache
@@ -91,7 +78,7 @@ def main() -> None:
     bench.parser.add_argument("--limit", type=int, default=None, help="this many test episodes, evenly spread")
     bench.parser.add_argument("--no-tracking", action="store_true",
                               help="send the model's joints to the motors as they are")
-    bench.parser.add_argument("--set", nargs="+", type=option, default=[], metavar="KEY=VALUE",
+    bench.parser.add_argument("--set", nargs="+", type=key_value, default=[], metavar="KEY=VALUE",
                               help="training options changed from the recipe (a candidate recipe)")
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="models trained and run side by side, each in its own process")

@@ -17,11 +17,10 @@ Run it on an otherwise idle machine.
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from dataclasses import fields, replace
 
-from harness import Benchmark
+from harness import Benchmark, key_value
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
 from pgae_lite.original import load_original
 from pgae_lite.train import train
@@ -32,16 +31,12 @@ TRAIN_OPTIONS = {f.name for f in fields(TrainConfig)} - {"epochs", "seed", "max_
 
 def candidate(text: str) -> dict:
     """``KEY=VALUE[,KEY=VALUE...]``: options of ModelConfig or TrainConfig (values JSON where they parse)."""
-    changes = {}
-    for part in text.split(","):
-        key, sep, raw = part.partition("=")
-        if not sep or key not in MODEL_OPTIONS | TRAIN_OPTIONS:
-            raise argparse.ArgumentTypeError(
-                f"expected KEY=VALUE with KEY one of {', '.join(sorted(MODEL_OPTIONS | TRAIN_OPTIONS))}; got {part!r}")
-        try:
-            changes[key] = json.loads(raw)
-        except json.JSONDecodeError:
-            changes[key] = raw
+    changes = dict(key_value(part) for part in text.split(","))
+    unknown = sorted(set(changes) - (MODEL_OPTIONS | TRAIN_OPTIONS))
+    if unknown:
+        raise argparse.ArgumentTypeError(
+            f"unknown option(s) {', '.join(unknown)} in {text!r}; the options are: "
+            f"{', '.join(sorted(MODEL_OPTIONS | TRAIN_OPTIONS))}")
     return changes
 
 

@@ -48,6 +48,17 @@ ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "results"
 
 
+def key_value(text: str) -> tuple[str, object]:
+    """``KEY=VALUE`` from the command line: the key and its value (JSON where it parses, else the text)."""
+    key, sep, raw = text.partition("=")
+    if not sep or not key:
+        raise argparse.ArgumentTypeError(f"expected KEY=VALUE, got {text!r}")
+    try:
+        return key, json.loads(raw)
+    except json.JSONDecodeError:
+        return key, raw
+
+
 def commit() -> str:
     """The checkout's commit, marked when the tree has uncommitted changes (outside results/)."""
     def git(*a: str) -> str:
