@@ -193,8 +193,8 @@ class Normaliser:
     together; we use the training split only, so the test set stays unseen.
     With ``vision_scaling="whiten"`` the visual features of both views are first
     whitened with one transform (:func:`whitening`, fitted on NICO's own view of
-    the training split, so that one picture means the same numbers in both
-    views), then scaled.
+    the training split), then scaled with the min and max of NICO's own view:
+    one picture means the same numbers in both views.
     """
 
     joints: tuple[float, float]
@@ -226,10 +226,12 @@ class Normaliser:
                                       f"constant ({lo:g}) in the training samples: "
                                       "nothing to scale")
             return lo, hi
-        return cls(lo_hi("joints", data.joints),
-                   lo_hi("visual features", _whiten(data.vision, white)),
-                   lo_hi("opposite views", _whiten(data.vision_opposite, white)),
-                   white)
+        vision = lo_hi("visual features", _whiten(data.vision, white))
+        # Whitened, the opposite view takes NICO's view's min and max too. With a min and max of its
+        # own, a few directions in which only that view varies set its scale and squeezed the opposite
+        # agent's motion into half the range, and PGAE-opposite described less (A2, "Visual features").
+        opposite = vision if white else lo_hi("opposite views", data.vision_opposite)
+        return cls(lo_hi("joints", data.joints), vision, opposite, white)
 
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
         if self.whitening is None:

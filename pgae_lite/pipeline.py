@@ -119,7 +119,7 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     is training the same model into the cache (two chapters run side by side), this
     waits for it and then loads its model.
     """
-    from .train import CHECKPOINT, load_checkpoint, train
+    from .train import CHECKPOINT, DataMismatchError, load_checkpoint, train
 
     if training not in TRAININGS:
         raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
@@ -138,6 +138,10 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     while True:
         try:
             return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+        except DataMismatchError as e:  # the cache's data and CAE are this model's own (its folder's name),
+            warnings.warn(f"cached model not used, training it again: {e}",   # so the scaling of
+                          stacklevel=2)  # the data changed since (an older pgae_lite): train it anew
+            (folder / CHECKPOINT).unlink()
         except FolderBusyError:           # another process trains this very model into the cache:
             if progress and not announced:  # wait for it, then load what it trained
                 print(f"{training}: another process is training this model; waiting for it ...", flush=True)

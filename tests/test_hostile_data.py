@@ -212,6 +212,22 @@ def test_a_damaged_cached_pgae_is_trained_again(toy_short, monkeypatch):
     assert again.history == first.history
 
 
+def test_a_cached_pgae_with_other_data_statistics_is_trained_again(toy_short, monkeypatch):
+    # A model cached by a pgae_lite that scaled the data otherwise: its saved normaliser differs.
+    monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
+    small = dict(max_train_samples=8, batch_size=4, epochs=1)
+    before = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT))
+    first = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **small)
+    [path] = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT)) - before
+    ckpt = load_checkpoint(path)
+    lo, hi = ckpt["normaliser"]["vision_opposite"]
+    ckpt["normaliser"]["vision_opposite"] = [lo - 1.0, hi + 1.0]
+    save_torch(ckpt, path)
+    with pytest.warns(UserWarning, match=r"training it again: .*\(vision_opposite\)"):
+        again = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **small)
+    assert again.history == first.history and load_checkpoint(path)["normaliser"]["vision_opposite"] == [lo, hi]
+
+
 # ------------------------------------------------------------------ checkpoints
 def _checkpoint(tmp_path: Path, toy_short) -> Path:
     train(toy_short, _tiny(), out_dir=tmp_path, progress=False, device="cpu")
