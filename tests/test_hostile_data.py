@@ -199,32 +199,36 @@ def test_a_bad_features_cache_is_computed_again(smoke_episodes, toy):
     np.testing.assert_array_equal(again.vision, data.vision)
 
 
-def test_a_damaged_cached_pgae_is_trained_again(toy_short, monkeypatch):
-    # The toy dataset stands in for the simulated one, as in test_pipeline.
+SMALL = dict(max_train_samples=8, batch_size=4, epochs=1)
+
+
+def _cached_pgae(toy_short, monkeypatch, seed: int):
+    """A tiny PGAE trained into the cache, and its checkpoint's path. (The toy dataset stands in
+    for the simulated one, as in test_pipeline.)"""
     monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
-    small = dict(max_train_samples=8, batch_size=4, epochs=1)
     before = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT))
-    first = pipeline.trained_pgae("PGAE", "smoke", seed=5, progress=False, **small)
+    first = pipeline.trained_pgae("PGAE", "smoke", seed=seed, progress=False, **SMALL)
     [path] = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT)) - before
+    return first, path
+
+
+def test_a_damaged_cached_pgae_is_trained_again(toy_short, monkeypatch):
+    first, path = _cached_pgae(toy_short, monkeypatch, seed=5)
     path.write_bytes(path.read_bytes()[:1000])
     with pytest.warns(UserWarning, match="training it again: .* truncated or damaged"):
-        again = pipeline.trained_pgae("PGAE", "smoke", seed=5, progress=False, **small)
+        again = pipeline.trained_pgae("PGAE", "smoke", seed=5, progress=False, **SMALL)
     assert again.history == first.history
 
 
 def test_a_cached_pgae_with_other_data_statistics_is_trained_again(toy_short, monkeypatch):
     # A model cached by a pgae_lite that scaled the data otherwise: its saved normaliser differs.
-    monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
-    small = dict(max_train_samples=8, batch_size=4, epochs=1)
-    before = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT))
-    first = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **small)
-    [path] = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT)) - before
+    first, path = _cached_pgae(toy_short, monkeypatch, seed=6)
     ckpt = load_checkpoint(path)
     lo, hi = ckpt["normaliser"]["vision_opposite"]
     ckpt["normaliser"]["vision_opposite"] = [lo - 1.0, hi + 1.0]
     save_torch(ckpt, path)
     with pytest.warns(UserWarning, match=r"training it again: .*\(vision_opposite\)"):
-        again = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **small)
+        again = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **SMALL)
     assert again.history == first.history and load_checkpoint(path)["normaliser"]["vision_opposite"] == [lo, hi]
 
 
