@@ -119,7 +119,7 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     is training the same model into the cache (two chapters run side by side), this
     waits for it and then loads its model.
     """
-    from .train import CHECKPOINT, DataMismatchError, load_checkpoint, train
+    from .train import CHECKPOINT, DataMismatchError, train
 
     if training not in TRAININGS:
         raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
@@ -127,20 +127,14 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     dataset = simulated_dataset(name, device, progress)
     prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
     folder = _model_folder(prof, training)
-    if (folder / CHECKPOINT).exists():
-        try:
-            load_checkpoint(folder / CHECKPOINT)
-        except CorruptCheckpointError as e:   # damaged: trained again, like the CAE
-            warnings.warn(f"cached model not used, training it again: {e}",
-                          stacklevel=2)
-            (folder / CHECKPOINT).unlink()
     announced = False
     while True:
         try:
             return train(dataset, prof, out_dir=folder, device=device, progress=progress)
-        except DataMismatchError as e:  # the cache's data and CAE are this model's own (its folder's name),
-            warnings.warn(f"cached model not used, training it again: {e}",   # so the scaling of
-                          stacklevel=2)  # the data changed since (an older pgae_lite): train it anew
+        # Damaged, or saved with other data statistics (the folder's name fixes the data and CAE, so an
+        # older pgae_lite scaled them otherwise): trained again, like the CAE.
+        except (CorruptCheckpointError, DataMismatchError) as e:
+            warnings.warn(f"cached model not used, training it again: {e}", stacklevel=2)
             (folder / CHECKPOINT).unlink()
         except FolderBusyError:           # another process trains this very model into the cache:
             if progress and not announced:  # wait for it, then load what it trained
