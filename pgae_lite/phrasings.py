@@ -23,11 +23,13 @@ the lexicon's phrases in a text.
 """
 from __future__ import annotations
 
+import itertools
 import random
 import re
 
 from .errors import ArgumentError
 from .phrase_lexicon import LEXICON, MEANINGS, SLOTS, PhraseLexicon, words_of
+from .utils import config_digest
 from .validate_api import instance_of, whole_number
 
 
@@ -159,6 +161,16 @@ def phrasings(action: str, colour: str, speed: str, n: int, seed: int = 0,
                         f"the lexicon gave for {action} {colour} {speed}")
 
 
+def phrasings_digest(n: int, seed: int = 0, lexicon: PhraseLexicon | None = None) -> str:
+    """12 hex digits naming the ``n`` sentences :func:`phrasings` gives every meaning.
+
+    Part of the cache name of a model trained on phrasings: an edited lexicon or
+    grammar gives other sentences, so the model is trained again, never reused.
+    """
+    return config_digest([phrasings(*meaning, n, seed=seed, lexicon=lexicon)
+                          for meaning in itertools.product(*MEANINGS.values())])
+
+
 def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
                   ) -> dict[str, list[str]]:
     """The meaning of each slot phrase in ``text``, by slot; longest phrases first.
@@ -192,4 +204,4 @@ def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
     return found
 
 
-__all__ = ["gerund", "phrasing", "phrasings", "slot_meanings"]
+__all__ = ["gerund", "phrasing", "phrasings", "phrasings_digest", "slot_meanings"]

@@ -28,6 +28,8 @@ import numpy as np
 from .cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from .config import TRAININGS, get_profile, profile_name, training_profile
 from .data import DataFormatError, PGAEDataset
+from .phrase_lexicon import training_lexicon
+from .phrasings import phrasings_digest
 from .simdata import DatasetConfig, generate, to_dataset, training_frames
 from .utils import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest
 
@@ -101,8 +103,13 @@ def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
 
 
 def _model_folder(prof, training: str) -> Path:
-    """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests."""
-    return cache_dir() / "pgae" / f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
+    """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
+    (and, for a training on phrasings, the sentences' own)."""
+    name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
+    if prof.train.phrasings:
+        name += "-" + phrasings_digest(prof.train.phrasings, prof.train.seed,
+                                       training_lexicon(prof.train.phrasing_words))
+    return cache_dir() / "pgae" / name
 
 
 def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,

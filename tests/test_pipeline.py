@@ -81,3 +81,20 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
     trained = pipeline.trained_pgae("PGAE", "smoke", 7, device="cpu", progress=True)
     assert other.wait(10) == 0 and trained.model.plan_head is not None
     assert "another process is training this model; waiting" in capsys.readouterr().out
+
+
+def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(monkeypatch):
+    from dataclasses import replace
+
+    import pgae_lite.phrase_lexicon as phrase_lexicon
+    from pgae_lite.config import training_profile
+    from pgae_lite.utils import config_digest
+
+    prof = training_profile(get_profile("smoke"), "PGAE-BERT-phrasings")
+    before = pipeline._model_folder(prof, "PGAE-BERT-phrasings")
+    assert pipeline._model_folder(prof, "PGAE-BERT-phrasings") == before        # the same sentences, the same model
+    shorter = replace(phrase_lexicon.LEXICON, carriers=phrase_lexicon.LEXICON.carriers[:-1])
+    monkeypatch.setattr(phrase_lexicon, "LEXICON", shorter)                      # one carrier sentence less
+    assert pipeline._model_folder(prof, "PGAE-BERT-phrasings") != before
+    plain = training_profile(get_profile("smoke"), "PGAE")                       # no phrasings: named as before
+    assert pipeline._model_folder(plain, "PGAE").name.endswith(f"-PGAE-{config_digest(plain.to_dict())}")
