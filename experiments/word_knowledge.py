@@ -8,10 +8,11 @@ carrier sentence per slot (``{} the red cube slowly`` for an action,
 and read as the mean of its token vectors there. A word of
 :func:`pgae_lite.phrase_lexicon.held_out_words` is given the meaning of the
 training word (of ``PGAE-BERT-phrasings-held-out``'s lexicon) whose vector is
-closest by cosine. A held-out word that lands nearest another meaning is one that
-no read-out trained on the other words can be expected to get right: this
-bounds what the unseen-word measure of ``benchmarks/free_language.py`` can
-reach with this encoder. The test paraphrases are never read.
+closest by cosine. A held-out word that lands nearest another meaning is one the
+encoder does not place with its meaning, so a read-out trained on the other words
+has little to go on for it: a guide to the unseen-word measure of
+``benchmarks/free_language.py``, not a bound (a trained read-out also uses the
+rest of the sentence). The test paraphrases are never read.
 """
 import argparse
 
