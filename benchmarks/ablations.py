@@ -1,6 +1,7 @@
 """Chapter 04's ablation exercises at the recipe, three seeds: the reference their solutions quote.
 
     python benchmarks/ablations.py [--ablations concat no-both ...] [--seeds 0 1 2] [--threads 1] [--workers 2]
+                                   [--epochs 30 --out results/ablations-short.json]
 
 Each ablation changes one thing of the profile's recipe (``book``), exactly as its
 exercise's solution does, and trains PGAE on our simulated data (the
@@ -9,12 +10,15 @@ chapter's data) once per seed; the recipe itself (``recipe``, the cached
 Writes every model's Table 1 cells and training time to
 results/ablations.json, so a solution can say whether its effect exceeds the
 spread of the seeds. With ``--workers N`` N models train side by side, each in
-its own process on one thread.
+its own process on one thread. With ``--epochs E`` the recipe and every change
+train for E epochs instead of the profile's (its schedule scaled to them): a
+shorter budget shows what a change does to the speed of learning.
 """
 from __future__ import annotations
 
 import copy
 import functools
+from dataclasses import replace
 
 import torch
 from torch import nn
@@ -67,16 +71,21 @@ def peephole(profile):
 ABLATIONS = {
     "concat": (None, concat_model),
     "cells": (peephole, None),
-    "no-both": (lambda p: get_profile(p.name, seed=p.train.seed, signal_probs=NO_BOTH), None),
-    "per-batch": (lambda p: get_profile(p.name, seed=p.train.seed, signals_per_sample=False), None),
+    "no-both": (lambda p: replace(p, train=replace(p.train, signal_probs=NO_BOTH)), None),
+    "per-batch": (lambda p: replace(p, train=replace(p.train, signals_per_sample=False)), None),
     "embedding": (None, small_embeddings),
     "weights": ("flat word weights", None),
 }
 
 
-def train_ablation(name: str, data, profile_name: str, seed: int):
+def budget(epochs: int | None) -> dict:
+    """The training options that set the budget: none (the profile's), or ``epochs``."""
+    return {"epochs": epochs} if epochs else {}
+
+
+def train_ablation(name: str, data, profile_name: str, seed: int, epochs: int | None = None):
     change, build = ABLATIONS[name]
-    profile = get_profile(profile_name, seed=seed)
+    profile = get_profile(profile_name, seed=seed, **budget(epochs))
     if callable(change):
         profile = change(profile)
     model = build(profile) if build else None
@@ -93,13 +102,13 @@ def train_ablation(name: str, data, profile_name: str, seed: int):
 dataset = functools.cache(simulated_dataset)
 
 
-def measure(name: str, seed: int, profile_name: str, threads: int | None) -> dict:
+def measure(name: str, seed: int, profile_name: str, threads: int | None, epochs: int | None = None) -> dict:
     """One model (the recipe's or one ablation's) trained on our data and its Table 1 cells."""
     if threads:
         torch.set_num_threads(threads)
     data = dataset(profile_name, "cpu", progress=False)
-    trained = (trained_pgae("PGAE", profile_name, seed, device="cpu", progress=False) if name == "recipe"
-               else train_ablation(name, data, profile_name, seed))
+    trained = (trained_pgae("PGAE", profile_name, seed, device="cpu", progress=False, **budget(epochs))
+               if name == "recipe" else train_ablation(name, data, profile_name, seed, epochs))
     cells, _ = evaluate(trained.model, data, trained.normaliser)
     print(name, seed, {s: (round(c["accuracy"], 2), round(c["nrmse"], 3)) for s, c in cells.items()},
           flush=True)
@@ -112,11 +121,15 @@ def main() -> None:
     bench.parser.add_argument("--ablations", nargs="+", default=list(ABLATIONS), choices=list(ABLATIONS))
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="models trained side by side, each in its own process")
+    bench.parser.add_argument("--epochs", type=int, default=None,
+                              help="train the recipe and every change for this many epochs (default: the profile's)")
     args = bench.parse()
     dataset(args.profile, "cpu", progress=False)                # recorded once, before the workers start
     threads = 1 if args.workers > 1 else args.threads
-    jobs = [(name, seed, args.profile, threads) for name in ["recipe", *args.ablations] for seed in args.seeds]
-    bench.write({"data": "ours (simulated)", "runs": side_by_side(measure, jobs, args.workers)})
+    jobs = [(name, seed, args.profile, threads, args.epochs) for name in ["recipe", *args.ablations]
+            for seed in args.seeds]
+    bench.write({"data": "ours (simulated)", "epochs": args.epochs or get_profile(args.profile).train.epochs,
+                 "runs": side_by_side(measure, jobs, args.workers)})
 
 
 if __name__ == "__main__":   # recording the data spawns workers, which re-import this file
