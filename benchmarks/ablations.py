@@ -88,6 +88,8 @@ def train_ablation(name: str, data, profile_name: str, seed: int, epochs: int | 
     profile = get_profile(profile_name, seed=seed, **budget(epochs))
     if callable(change):
         profile = change(profile)
+    if build:           # its initial weights the same for the same seed, whatever this process ran before
+        torch.manual_seed(seed)
     model = build(profile) if build else None
     saved = dict(language.WORD_WEIGHTS)
     if change == "flat word weights":             # ex-pgae-weights: every word weighs 1
