@@ -10,9 +10,10 @@ takes a description (execute, repeat both, repeat language; or those of
 description in other words (:func:`pgae_lite.phrasings.phrasings`, a grammar
 and lexicon written for the purpose, independent of the held-out test
 sentences) instead of the description itself. The targets stay the dataset's
-words. The encoder stays frozen: the K sentences of each meaning and signal
-are encoded once (``3 x 36 x K`` sentences) and kept on disk like its table of
-fixed inputs, so a training step costs what PGAE-BERT's costs.
+words. The encoder stays frozen: the K sentences of each meaning and reading
+signal are encoded once (``S x 36 x K`` sentences for S signals) and kept on
+disk like its table of fixed inputs, so a training step costs what PGAE-BERT's
+costs.
 """
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, 
 
 
 class PhrasingBank:
-    """Sentence vectors of K phrasings per (signal, meaning): a tensor (3, 36, K, D)."""
+    """Sentence vectors of K phrasings per (reading signal, meaning): a tensor (S, 36, K, D), S <= 3."""
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
                  lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
@@ -44,15 +45,17 @@ class PhrasingBank:
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
                              f"{type(encoder).__name__}")
         self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
-        self.texts = [input_text(SIGNALS[s], text) for s in TEXT_SIGNALS for m in MEANINGS
+        # only the signals that read phrasings are encoded (the others' rows would never be read)
+        self.signals = tuple(s for s in TEXT_SIGNALS if signals is None or SIGNALS[s] in signals)
+        self.texts = [input_text(SIGNALS[s], text) for s in self.signals for m in MEANINGS
                       for text in phrasings(*m, per_meaning, seed=seed, lexicon=lexicon)]
-        shape = (len(TEXT_SIGNALS), len(MEANINGS), per_meaning)
+        shape = (len(self.signals), len(MEANINGS), per_meaning)
         device = next(encoder.buffers()).device
         if isinstance(encoder, AttentivePretrainedEncoder):
             # token vectors, pooled by the trained attention at every step; float16 halves their memory
             states, mask = cached_token_vectors(encoder.transformer, self.texts, "phrasings", torch.float16)
-            self.states = states.reshape(*shape, *states.shape[1:]).to(device)   # (3, 36, K, T, D)
-            self.mask = mask.reshape(*shape, -1).to(device)                       # (3, 36, K, T)
+            self.states = states.reshape(*shape, *states.shape[1:]).to(device)   # (S, 36, K, T, D)
+            self.mask = mask.reshape(*shape, -1).to(device)                       # (S, 36, K, T)
         else:
             key = config_digest({"texts": self.texts, "encoder": encoder.transformer.digest,
                                  "pooling": encoder.pooling})
@@ -60,19 +63,18 @@ class PhrasingBank:
             if path.exists():
                 vectors = load_torch(path, ("vectors",), what="phrasing cache")["vectors"]
             else:
-                vectors = encoder._run_transformer(self.texts)          # (3·36·K, D), once
+                vectors = encoder._run_transformer(self.texts)          # (S·36·K, D), once
                 save_torch({"vectors": vectors}, path)
-            self.vectors = vectors.reshape(*shape, -1).to(device)        # (3, 36, K, D)
+            self.vectors = vectors.reshape(*shape, -1).to(device)        # (S, 36, K, D)
         # input token -> its canonical word's position in its slot (-1: not a description word)
         self.slot_index = torch.full((len(VOCABULARY),), -1, dtype=torch.long)
         for word, canonical in CANONICAL.items():
             slot = next(slot for slot in SLOTS if canonical in slot)
             self.slot_index[VOCABULARY.index(word)] = slot.index(canonical)
-        # signal -> its row in the bank (-1: the signal reads no phrasings; all are encoded, one cache)
+        # signal -> its row in the bank (-1: the signal reads no phrasings)
         self.signal_row = torch.full((len(SIGNALS),), -1, dtype=torch.long)
-        for row, s in enumerate(TEXT_SIGNALS):
-            if signals is None or SIGNALS[s] in signals:
-                self.signal_row[s] = row
+        for row, s in enumerate(self.signals):
+            self.signal_row[s] = row
 
     def meanings(self, tokens: torch.Tensor) -> torch.Tensor:
         """``lang_tokens`` (B, 5) with a description -> meaning index 0..35 (B,)."""

@@ -106,9 +106,9 @@ def _model_folder(prof, training: str) -> Path:
     """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
     (and, for a training on phrasings, the sentences' own)."""
     name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
-    if prof.train.phrasings:
+    if prof.train.phrasings:   # "-b2": the bank encodes only the signals that read phrasings (other rounding)
         name += "-" + phrasings_digest(prof.train.phrasings, prof.train.seed,
-                                       training_lexicon(prof.train.phrasing_words))
+                                       training_lexicon(prof.train.phrasing_words)) + "-b2"
     return cache_dir() / "pgae" / name
 
 

@@ -79,6 +79,15 @@ def test_phrasing_signals_choose_which_samples_read_phrasings(bert, toy_tensors)
         TrainConfig(phrasing_signals=("describe",))
 
 
+def test_only_the_signals_that_read_phrasings_are_encoded(bert):
+    every = PhrasingBank(bert.language_encoder, 2, seed=0)
+    one = PhrasingBank(bert.language_encoder, 2, seed=0, signals=("repeat language",))
+    assert one.vectors.shape == (1, 36, 2, bert.language_encoder.output_dim) and len(one.texts) == 72
+    assert one.signal_row.tolist() == [-1 if s != "repeat language" else 0 for s in SIGNALS]
+    row = TEXT_SIGNALS.index(SIGNALS.index("repeat language"))
+    torch.testing.assert_close(one.vectors[0], every.vectors[row], atol=1e-5, rtol=1e-4)   # the same sentences
+
+
 def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short):
     profile = get_profile("smoke")
     profile.model = replace(profile.model, language_encoder="pretrained")
