@@ -2,7 +2,7 @@
 
     python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
     python experiments/validation_readback.py PGAE-BERT-phrasings:0:input_noise=0.05
-    python experiments/validation_readback.py "PGAE-BERT-phrasings:1:phrasing_signals=repeat language"
+    python experiments/validation_readback.py PGAE-BERT-phrasings:1:phrasing_prob=0.5
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
@@ -28,7 +28,7 @@ from pgae_lite.language import LanguageError, parse_description
 from pgae_lite.patterns import Pattern
 from pgae_lite.phrase_lexicon import held_out_words, words_of
 from pgae_lite.phrasings import phrasings
-from pgae_lite.config import TrainConfig, get_profile
+from pgae_lite.config import TRAININGS, TrainConfig, get_profile
 from pgae_lite.instructions import ROUTES, execute_paraphrases
 from pgae_lite.paraphrases import Paraphrase
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
@@ -60,6 +60,12 @@ parser.add_argument("--closed", action="store_true", help="also execute the sent
 parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
                     help="how the closed loop reads the sentence (pgae_lite.instructions.ROUTES)")
 args = parser.parse_args()
+for spec in args.models:   # an option the training sets itself would be overwritten: refused, not ignored
+    training, _, *options = spec.split(":")
+    fixed = sorted({option.split("=")[0] for option in options} & set(TRAININGS[training].train))
+    if fixed:
+        parser.error(f"{spec}: {', '.join(fixed)} is set by the training {training} itself "
+                     f"({TRAININGS[training].train}); change it in pgae_lite.config.TRAININGS instead")
 torch.set_num_threads(1)
 
 data = simulated_dataset("book", progress=False)
