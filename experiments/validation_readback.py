@@ -60,9 +60,11 @@ parser.add_argument("--closed", action="store_true", help="also execute the sent
 parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
                     help="how the closed loop reads the sentence (pgae_lite.instructions.ROUTES)")
 args = parser.parse_args()
-for spec in args.models:   # an option the training sets itself would be overwritten: refused, not ignored
-    training, _, *options = spec.split(":")
-    fixed = sorted({option.split("=")[0] for option in options} & set(TRAININGS[training].train))
+models = {}                # spec -> (training, seed, options), each checked before anything loads
+for spec in args.models:
+    training, seed, *options = spec.split(":")
+    models[spec] = training, int(seed), dict(option.split("=") for option in options)
+    fixed = sorted(set(models[spec][2]) & set(TRAININGS[training].train))   # the training would overwrite them
     if fixed:
         parser.error(f"{spec}: {', '.join(fixed)} is set by the training {training} itself "
                      f"({TRAININGS[training].train}); change it in pgae_lite.config.TRAININGS instead")
@@ -83,10 +85,8 @@ for i, number in enumerate(test.pattern):
     unseen.append(bool(set(words_of(text)) & held))
 unseen = np.array(unseen)
 
-for spec in args.models:
-    training, seed, *options = spec.split(":")
-    options = dict(option.split("=") for option in options)
-    trained = trained_pgae(training, "book", int(seed), device="cpu", progress=False,
+for spec, (training, seed, options) in models.items():
+    trained = trained_pgae(training, "book", seed, device="cpu", progress=False,
                            **{k: option_value(k, v) for k, v in options.items()})
     heard = trained.model.language_encoder.encode_texts(texts)
     back = predict(trained.model, test, trained.normaliser, "repeat language", language=heard)
