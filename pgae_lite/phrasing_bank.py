@@ -12,8 +12,10 @@ and lexicon written for the purpose, independent of the held-out test
 sentences) instead of the description itself. The targets stay the dataset's
 words. The encoder stays frozen: the K sentences of each meaning and reading
 signal are encoded once (``S x 36 x K`` sentences for S signals) and kept on
-disk like its table of fixed inputs, so a training step costs what PGAE-BERT's
-costs.
+disk like its table of fixed inputs. A training step then adds only the pooling
+of the picked sentences: a lookup of their sentence vectors for the mean, and
+for the attention pooling (:mod:`pgae_lite.attention_pooling`) the trained
+attention over their cached token vectors; the transformer never runs in a step.
 """
 from __future__ import annotations
 
