@@ -21,6 +21,9 @@ Modules, in the order the book introduces them:
 - ``train``       loss, training loop, checkpoints
 - ``evaluate``    Table 1: description accuracy and joint nRMSE
 - ``pretrained``  PGAE-BERT's frozen transformer language encoder (chapter 05)
+- ``phrasings``, ``phrase_lexicon``, ``phrasing_bank``  generated ways of saying each instruction (chapter 05)
+- ``attention_pooling``, ``tuned_layer``  the free-form variant's encoder: attention over the tokens,
+                  the top layer tuned for free text (chapter 05)
 - ``reproduce``   every row of Table 1 (PGAE, PGAE-BERT, PGAE-self, PGAE-opposite) over seeds
 - ``closedloop``  the model drives the simulated robot, open and closed loop (chapter 07)
 - ``instructions`` free-form instructions, executed both ways (chapter 07)

@@ -91,7 +91,7 @@ def make_language_encoder(cfg: ModelConfig,
         # Imported here: transformers loads only when PGAE-BERT is used.
         if cfg.language_encoder == "pretrained-attention":   # not in the paper: attention_pooling.py
             from .attention_pooling import AttentivePretrainedEncoder
-            return AttentivePretrainedEncoder(cfg.pretrained_model)
+            return AttentivePretrainedEncoder(cfg.pretrained_model, tuned=cfg.tuned_top_layer)
         from .pretrained import PretrainedLanguageEncoder
         return PretrainedLanguageEncoder(cfg.pretrained_model)
     raise ValueError(f"unknown language_encoder {cfg.language_encoder!r}; "

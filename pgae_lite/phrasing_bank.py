@@ -10,12 +10,14 @@ takes a description (execute, repeat both, repeat language; or those of
 description in other words (:func:`pgae_lite.phrasings.phrasings`, a grammar
 and lexicon written for the purpose, independent of the held-out test
 sentences) instead of the description itself. The targets stay the dataset's
-words. The encoder stays frozen: the K sentences of each meaning and reading
+words. The transformer stays frozen (up to its top layer, when that is tuned:
+:mod:`pgae_lite.tuned_layer`): the K sentences of each meaning and reading
 signal are encoded once (``S x 36 x K`` sentences for S signals) and kept on
-disk like its table of fixed inputs. A training step then adds only the pooling
-of the picked sentences: a lookup of their sentence vectors for the mean, and
-for the attention pooling (:mod:`pgae_lite.attention_pooling`) the trained
-attention over their cached token vectors; the transformer never runs in a step.
+disk like its table of fixed inputs. A training step then adds only what comes
+after the cache for the picked sentences: a lookup of their sentence vectors
+for the mean; for the attention pooling (:mod:`pgae_lite.attention_pooling`)
+the trained attention over their cached token vectors, and before it the tuned
+top layer, if there is one, over the cached input of that layer.
 """
 from __future__ import annotations
 
@@ -30,6 +32,7 @@ from .attention_pooling import AttentivePretrainedEncoder, cached_token_vectors
 from .config import TrainConfig
 from .pretrained import PretrainedLanguageEncoder, input_text
 from .signals import LANG_IN, SignalBatch
+from .tuned_layer import TRAIN_EVERY
 from .utils import cache_dir, config_digest, load_torch, save_torch
 
 MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
@@ -47,6 +50,7 @@ class PhrasingBank:
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
                              f"{type(encoder).__name__}")
         self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
+        self.steps = 0                                   # calls of features(): training steps
         # only the signals that read phrasings are encoded (the others' rows would never be read)
         self.signals = tuple(s for s in TEXT_SIGNALS if signals is None or SIGNALS[s] in signals)
         self.texts = [input_text(SIGNALS[s], text) for s in self.signals for m in MEANINGS
@@ -55,7 +59,7 @@ class PhrasingBank:
         device = next(encoder.buffers()).device
         if isinstance(encoder, AttentivePretrainedEncoder):
             # token vectors, pooled by the trained attention at every step; float16 halves their memory
-            states, mask = cached_token_vectors(encoder.transformer, self.texts, "phrasings", torch.float16)
+            states, mask = encoder.free_text_vectors(self.texts, "phrasings", torch.float16)
             self.states = states.reshape(*shape, *states.shape[1:]).to(device)   # (S, 36, K, T, D)
             self.mask = mask.reshape(*shape, -1).to(device)                       # (S, 36, K, T)
         else:
@@ -87,6 +91,7 @@ class PhrasingBank:
                  generator: torch.Generator) -> torch.Tensor:
         """The language features of a training batch (B, D): phrasings for some samples."""
         base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
+        self.steps += 1
         size = len(batch.signal)
         row = self.signal_row[batch.signal.cpu()]                            # (B,), -1: no description
         takes = (row >= 0) & (torch.rand(size, generator=generator) < self.prob)
@@ -97,7 +102,9 @@ class PhrasingBank:
         meaning = self.meanings(batch.lang_tokens[rows])
         pick = (row[rows], meaning, which[rows])
         if isinstance(self.encoder, AttentivePretrainedEncoder):
-            said = self.encoder.pool(self.states[pick], self.mask[pick])   # trained: gradients flow
+            # a tuned top layer learns from the phrasings of one step in TRAIN_EVERY (forward only on the others)
+            said = self.encoder.pool_free_text(self.states[pick], self.mask[pick],    # trained: gradients flow
+                                               train_top=self.steps % TRAIN_EVERY == 0)
         else:
             said = self.vectors[pick]
         return base.index_put((rows.to(base.device),), said)
