@@ -69,7 +69,7 @@ class ModelConfig:
     language_encoder: str = "lstm"
     pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
     # Not in the paper (which keeps the transformer frozen): with "pretrained-attention", free text reads
-    # the transformer's top layer trained at lr/100 (tuned_layer.py); the 869 fixed inputs stay frozen.
+    # the transformer's top layer trained (tuned_layer.py, lr x LR_SCALE); the 869 fixed inputs stay frozen.
     tuned_top_layer: bool = False
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
     # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for

@@ -67,7 +67,7 @@ def lr_factor(step: int, total: int, warmup: float, schedule: str) -> float:
 
 def parameter_groups(model: nn.Module) -> list[dict]:
     """The optimiser's groups: every weight at the recipe's rate, except those of a module with an
-    ``lr_scale`` (the tuned feed-forward block, tuned_layer.py): lr · lr_scale, no weight decay."""
+    ``lr_scale`` (the tuned top layer, tuned_layer.py): lr · lr_scale, no weight decay."""
     scaled = [m for m in model.modules() if hasattr(m, "lr_scale")]
     own = {id(p) for m in scaled for p in m.parameters()}
     groups = [{"params": [p for p in model.parameters() if id(p) not in own], "lr_scale": 1.0}]
