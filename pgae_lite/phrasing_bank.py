@@ -50,7 +50,6 @@ class PhrasingBank:
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
                              f"{type(encoder).__name__}")
         self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
-        self.steps = 0                                   # calls of features(): training steps
         # only the signals that read phrasings are encoded (the others' rows would never be read)
         self.signals = tuple(s for s in TEXT_SIGNALS if signals is None or SIGNALS[s] in signals)
         self.texts = [input_text(SIGNALS[s], text) for s in self.signals for m in MEANINGS
@@ -88,10 +87,11 @@ class PhrasingBank:
         return (a * len(SLOTS[1]) + c) * len(SLOTS[2]) + s
 
     def features(self, model: torch.nn.Module, batch: SignalBatch,
-                 generator: torch.Generator) -> torch.Tensor:
-        """The language features of a training batch (B, D): phrasings for some samples."""
+                 generator: torch.Generator, step: int = 0) -> torch.Tensor:
+        """The language features of a training batch (B, D): phrasings for some samples.
+
+        ``step``: the training step (from 0), which says whether a tuned top layer learns in it."""
         base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
-        self.steps += 1
         size = len(batch.signal)
         row = self.signal_row[batch.signal.cpu()]                            # (B,), -1: no description
         takes = (row >= 0) & (torch.rand(size, generator=generator) < self.prob)
@@ -104,7 +104,7 @@ class PhrasingBank:
         if isinstance(self.encoder, AttentivePretrainedEncoder):
             # a tuned top layer learns from the phrasings of one step in TRAIN_EVERY (forward only on the others)
             said = self.encoder.pool_free_text(self.states[pick], self.mask[pick],    # trained: gradients flow
-                                               train_top=self.steps % TRAIN_EVERY == 0)
+                                               train_top=(step + 1) % TRAIN_EVERY == 0)
         else:
             said = self.vectors[pick]
         return base.index_put((rows.to(base.device),), said)

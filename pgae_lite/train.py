@@ -220,7 +220,7 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
             batch = make_batch(data, index, signal, alternative, opposite)
             if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
                 batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
-            language = None if bank is None else bank.features(model, batch, gen)
+            language = None if bank is None else bank.features(model, batch, gen, step)
             out = model(batch, teacher_language=cfg.teacher_language,
                         feedback="greedy" if cfg.teacher_language else "soft", language=language)
             loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)

@@ -85,9 +85,9 @@ def test_the_bank_keeps_the_layers_input_and_reads_it_through_the_layer(tuned, t
     index = torch.arange(16)
     batch = make_batch(toy_tensors, index, torch.full((16,), SIGNALS.index("repeat language")), index % 8)
     generator = torch.Generator().manual_seed(0)
-    for step in range(1, 2 * TRAIN_EVERY + 1):     # the layer learns in one step of TRAIN_EVERY
-        bank.features(tuned, batch, generator).sum().backward()
-        assert (encoder.top.outer.weight.grad is not None) == (step % TRAIN_EVERY == 0), step
+    for step in range(2 * TRAIN_EVERY):             # the layer learns in one step of TRAIN_EVERY
+        bank.features(tuned, batch, generator, step).sum().backward()
+        assert (encoder.top.outer.weight.grad is not None) == ((step + 1) % TRAIN_EVERY == 0), step
         assert encoder.attention.score.weight.grad.abs().sum() > 0           # the pooling in every step
         encoder.zero_grad(set_to_none=True)
 
@@ -106,6 +106,28 @@ def test_training_tunes_saves_and_reloads_the_layer(toy_short, tmp_path):
     again, _, _ = load_model(tmp_path / "checkpoint.pt", device="cpu")
     trained.model.eval()
     torch.testing.assert_close(again.language_encoder.encode_texts(TEXTS), trained.model.language_encoder.encode_texts(TEXTS))
+
+
+class Interrupt(Exception):
+    pass
+
+
+def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path):
+    """Stopped after epoch 2 of 3 and trained again: the same weights, tuned layer included."""
+    profile = get_profile("smoke")
+    profile.model = replace(profile.model, language_encoder="pretrained-attention", tuned_top_layer=True)
+    profile.train = replace(profile.train, phrasings=2, phrasing_signals=("repeat language",),
+                            batch_size=24)   # 4 steps an epoch: the resumed epoch starts mid-cycle of three
+    whole = train(toy_short, profile, out_dir=tmp_path / "whole", progress=False, device="cpu")
+
+    def stop_at_3(epoch, model, record):
+        if epoch == 3:
+            raise Interrupt
+    with pytest.raises(Interrupt):
+        train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu", callback=stop_at_3)
+    resumed = train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu")
+    for name, weight in whole.model.state_dict().items():
+        assert torch.equal(weight, resumed.model.state_dict()[name]), name
 
 
 def test_clear_errors_and_the_keys_of_models_before():
