@@ -108,3 +108,24 @@ def set_threads():
     before = torch.get_num_threads()
     yield torch.set_num_threads
     torch.set_num_threads(before)
+
+
+@pytest.fixture
+def interrupt_training():
+    """``interrupt_training(dataset, profile, out_dir, epoch)``: ``train`` stopped by an exception raised
+    from its callback at ``epoch``, as if the process were killed there (to test resuming)."""
+    from pgae_lite.train import train
+
+    class Interrupt(Exception):
+        pass
+
+    def stop(epoch_to_stop: int):
+        def callback(epoch, model, record):
+            if epoch == epoch_to_stop:
+                raise Interrupt
+        return callback
+
+    def run(dataset, profile, out_dir, epoch: int) -> None:
+        with pytest.raises(Interrupt):
+            train(dataset, profile, out_dir=out_dir, progress=False, device="cpu", callback=stop(epoch))
+    return run

@@ -123,20 +123,12 @@ def test_finished_run_returns_at_once(toy_short, tmp_path):
     assert _same_weights(_weights(again.model), _weights(first.model))
 
 
-class Interrupt(Exception):
-    pass
-
-
-def test_resume_after_interruption_is_identical(toy_short, tmp_path):
+def test_resume_after_interruption_is_identical(toy_short, tmp_path, interrupt_training):
     """Stopping at epoch 3 of 5 (no checkpoint for it) and training again gives the same run."""
     prof = tiny_profile(epochs=5)
     whole = train(toy_short, prof, out_dir=tmp_path / "whole", progress=False, device="cpu")
 
-    def stop_at_3(epoch, model, record):
-        if epoch == 3:
-            raise Interrupt
-    with pytest.raises(Interrupt):
-        train(toy_short, prof, out_dir=tmp_path / "cut", progress=False, device="cpu", callback=stop_at_3)
+    interrupt_training(toy_short, prof, tmp_path / "cut", epoch=3)
     assert load_checkpoint(tmp_path / "cut" / CHECKPOINT)["epoch"] == 2
     epochs_run = []
     resumed = train(toy_short, prof, out_dir=tmp_path / "cut", progress=False, device="cpu",
@@ -146,16 +138,12 @@ def test_resume_after_interruption_is_identical(toy_short, tmp_path):
     assert _same_weights(_weights(resumed.model), _weights(whole.model))
 
 
-def test_resume_with_sparse_checkpoints(toy_short, tmp_path):
+def test_resume_with_sparse_checkpoints(toy_short, tmp_path, interrupt_training):
     """checkpoint_every=2: an interruption at epoch 4 resumes from epoch 2."""
     prof = tiny_profile(epochs=5, checkpoint_every=2)
     whole = train(toy_short, prof, progress=False, device="cpu")
 
-    def stop_at_4(epoch, model, record):
-        if epoch == 4:
-            raise Interrupt
-    with pytest.raises(Interrupt):
-        train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu", callback=stop_at_4)
+    interrupt_training(toy_short, prof, tmp_path, epoch=4)
     assert load_checkpoint(tmp_path / CHECKPOINT)["epoch"] == 2
     resumed = train(toy_short, prof, out_dir=tmp_path, progress=False, device="cpu")
     assert resumed.history == whole.history

@@ -108,23 +108,14 @@ def test_training_tunes_saves_and_reloads_the_layer(toy_short, tmp_path):
     torch.testing.assert_close(again.language_encoder.encode_texts(TEXTS), trained.model.language_encoder.encode_texts(TEXTS))
 
 
-class Interrupt(Exception):
-    pass
-
-
-def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path):
+def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path, interrupt_training):
     """Stopped after epoch 2 of 3 and trained again: the same weights, tuned layer included."""
     profile = get_profile("smoke")
     profile.model = replace(profile.model, language_encoder="pretrained-attention", tuned_top_layer=True)
     profile.train = replace(profile.train, phrasings=2, phrasing_signals=("repeat language",),
                             batch_size=24)   # 4 steps an epoch: the resumed epoch starts mid-cycle of three
     whole = train(toy_short, profile, out_dir=tmp_path / "whole", progress=False, device="cpu")
-
-    def stop_at_3(epoch, model, record):
-        if epoch == 3:
-            raise Interrupt
-    with pytest.raises(Interrupt):
-        train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu", callback=stop_at_3)
+    interrupt_training(toy_short, profile, tmp_path / "cut", epoch=3)
     resumed = train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu")
     for name, weight in whole.model.state_dict().items():
         assert torch.equal(weight, resumed.model.state_dict()[name]), name
