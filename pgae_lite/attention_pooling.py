@@ -28,7 +28,7 @@ from torch import nn
 
 from .pretrained import (Transformer, check_texts, fixed_inputs, load_transformer, model_name, table_rows,
                          token_vectors, tokens_to_text)
-from .tuned_layer import TunedTopLayer, top_input_vectors
+from .tuned_layer import TunedTopLayer
 from .utils import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 
 #: Attention heads (K). Deviation from paper: chosen on generated validation sentences
@@ -55,8 +55,8 @@ def padded_token_vectors(tf: Transformer, texts: list[str],
                          top_input: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
     """Texts -> token vectors (B, T, D) and mask (B, T), padded to the longest text, on the CPU.
 
-    ``top_input``: the top layer's input (tuned_layer.top_input_vectors), not the last layer's output."""
-    pieces = list((top_input_vectors if top_input else token_vectors)(tf, texts))
+    ``top_input``: the top layer's input (:func:`~pgae_lite.pretrained.token_vectors`), not its output."""
+    pieces = list(token_vectors(tf, texts, top_input=top_input))
     longest = max((h.shape[1] for h, _ in pieces), default=1)
     states = torch.cat([nn.functional.pad(h, (0, 0, 0, longest - h.shape[1])) for h, _ in pieces])
     mask = torch.cat([nn.functional.pad(m, (0, longest - m.shape[1])) for _, m in pieces])
@@ -129,15 +129,14 @@ class AttentivePretrainedEncoder(nn.Module):
         """:meth:`free_text_vectors` (B, T, D), (B, T) -> f (B, D), through ``top`` if tuned.
 
         ``train_top=False``: ``top`` runs without recording gradients (the attention pooling still learns)."""
-        if self.top is None:
-            return self.pool(states, mask)
-        device = self.mask.device
-        states, mask = states.to(device, torch.float32), mask.to(device)
-        longest = int(mask.any(0).nonzero().max()) + 1                       # drop columns of padding only
-        states, mask = states[:, :longest], mask[:, :longest]                # (B, T', D), (B, T')
-        with torch.set_grad_enabled(train_top and torch.is_grad_enabled()):
-            states = self.top(states, mask)                                  # (B, T', D)
-        return self.attention(states, mask)
+        if self.top is not None:
+            device = self.mask.device
+            states, mask = states.to(device, torch.float32), mask.to(device)
+            longest = int(mask.any(0).nonzero().max()) + 1                   # drop columns of padding only
+            states, mask = states[:, :longest], mask[:, :longest]            # (B, T', D), (B, T')
+            with torch.set_grad_enabled(train_top and torch.is_grad_enabled()):
+                states = self.top(states, mask)                              # (B, T', D)
+        return self.pool(states, mask)
 
     def encode_texts(self, texts: list[str]) -> torch.Tensor:
         """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``."""

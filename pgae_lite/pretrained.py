@@ -227,15 +227,19 @@ def table_rows(tokens: torch.Tensor, row_of_code: torch.Tensor) -> torch.Tensor:
 
 
 @torch.no_grad()
-def token_vectors(tf: Transformer, texts: list[str], batch_size: int = 128):
+def token_vectors(tf: Transformer, texts: list[str], batch_size: int = 128, top_input: bool = False):
     """The frozen transformer's last hidden states, a batch of texts at a time, on the CPU.
 
     Yields ``(hidden (b, tokens, D) float32, mask (b, tokens) bool)``; ``mask`` is False on padding.
+    ``top_input``: the hidden states below the last layer instead, the input of a tuned top layer
+    (:mod:`pgae_lite.tuned_layer`).
     """
     for i in range(0, len(texts), batch_size):
         enc = tf.tokenizer(list(texts[i:i + batch_size]), padding=True, truncation=True,
                            return_tensors="pt")
-        yield tf.model(**enc).last_hidden_state.float(), enc["attention_mask"].bool()
+        out = tf.model(**enc, output_hidden_states=top_input)
+        hidden = out.hidden_states[-2] if top_input else out.last_hidden_state
+        yield hidden.float(), enc["attention_mask"].bool()
 
 
 # --------------------------------------------------------------------------- the encoder

@@ -61,19 +61,6 @@ def _part(module: nn.Module | None, path: str) -> nn.Module | None:
     return module
 
 
-@torch.no_grad()
-def top_input_vectors(tf: Transformer, texts: list[str], batch_size: int = 128):
-    """x, the top layer's input, for each token, a batch of texts at a time, on the CPU.
-
-    Yields ``(x (b, tokens, D) float32, mask (b, tokens) bool)``, as
-    :func:`pgae_lite.pretrained.token_vectors` yields the last hidden states.
-    """
-    for i in range(0, len(texts), batch_size):
-        enc = tf.tokenizer(list(texts[i:i + batch_size]), padding=True, truncation=True, return_tensors="pt")
-        below = tf.model(**enc, output_hidden_states=True).hidden_states[-2]   # the top layer's input
-        yield below.float(), enc["attention_mask"].bool()
-
-
 class TunedTopLayer(nn.Module):
     """The top layer, trained: x (B, T, D) with mask (B, T) -> y (B, T, D)."""
 
@@ -105,4 +92,4 @@ class TunedTopLayer(nn.Module):
         return self.norm_2(h + self.dropout(self.outer(inner)))                    # y = LN_2(h + W_2 · ... + b_2)
 
 
-__all__ = ["LR_SCALE", "TRAIN_EVERY", "TunedTopLayer", "top_input_vectors", "top_layer"]
+__all__ = ["LR_SCALE", "TRAIN_EVERY", "TunedTopLayer", "top_layer"]

