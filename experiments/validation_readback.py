@@ -3,11 +3,14 @@
     python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
     python experiments/validation_readback.py PGAE-BERT-phrasings:0:input_noise=0.05
     python experiments/validation_readback.py PGAE-BERT-phrasings:1:phrasing_prob=0.5
+    python experiments/validation_readback.py PGAE-BERT-phrasings-held-out:0 --grammar second
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
 generates with another seed than any training uses; the model's description
-must name the intended action, colour and speed. This is the validation set a
+must name the intended action, colour and speed. With ``--grammar second`` the
+12 sentences come from :mod:`second_grammar` instead (other sentence forms,
+the same lexicon), a check that does not share the training grammar. This is the validation set a
 free-form variant is chosen on; ``pgae_lite/paraphrases.tsv`` stays the test
 set (``benchmarks/free_language.py``). The "held-out words" subset holds the
 sentences with a word of :func:`pgae_lite.phrase_lexicon.held_out_words`.
@@ -33,6 +36,7 @@ from pgae_lite.instructions import ROUTES, execute_paraphrases
 from pgae_lite.paraphrases import Paraphrase
 from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.pretrained import input_text
+from second_grammar import second_phrasings
 
 
 def parse(text: str) -> tuple[str, ...] | None:
@@ -56,6 +60,8 @@ REASONS = {"sideways": "sideways", "too little along": "along the direction", "o
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("models", nargs="+", help="TRAINING:SEED[:OPTION=NUMBER], e.g. PGAE-BERT-phrasings:0")
 parser.add_argument("--seed", type=int, default=4242, help="the phrasing grammar's seed (not a training one)")
+parser.add_argument("--grammar", choices=("training", "second"), default="training",
+                    help="the training grammar with another seed, or experiments/second_grammar.py's forms")
 parser.add_argument("--closed", action="store_true", help="also execute the sentences in the closed loop")
 parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
                     help="how the closed loop reads the sentence (pgae_lite.instructions.ROUTES)")
@@ -79,7 +85,8 @@ for i, number in enumerate(test.pattern):
     pattern = Pattern.from_number(int(number))
     meaning = (pattern.action, pattern.colour, pattern.speed)
     if meaning not in sentences:
-        sentences[meaning] = phrasings(*meaning, 12, seed=args.seed)
+        sentences[meaning] = (phrasings if args.grammar == "training" else second_phrasings)(
+            *meaning, 12, seed=args.seed)
     text = sentences[meaning][i % 12]
     texts.append(input_text("repeat language", text))
     unseen.append(bool(set(words_of(text)) & held))
