@@ -11,9 +11,10 @@ generates with another seed than any training uses; the model's description
 must name the intended action, colour and speed. With ``--grammar second``
 the 12 sentences come from :mod:`second_grammar` instead (other sentence
 forms, the same lexicon): a check that does not share the training grammar.
-This is the validation set a free-form variant is chosen on; ``pgae_lite/paraphrases.tsv`` stays the test
-set (``benchmarks/free_language.py``). The "held-out words" subset holds the
-sentences with a word of :func:`pgae_lite.phrase_lexicon.held_out_words`.
+This is the validation set a free-form variant is chosen on;
+``pgae_lite/paraphrases.tsv`` stays the test set (``benchmarks/free_language.py``).
+The "held-out words" subset holds the sentences with a word of
+:func:`pgae_lite.phrase_lexicon.held_out_words`.
 Models are trained with the book profile, or loaded from the cache; ``name=value``
 after the seed changes one training option that the training itself does not set (a number,
 or names joined by ``+``).
