@@ -23,20 +23,18 @@ import re
 import sys
 
 from pgae_lite.phrase_lexicon import LEXICON, MEANINGS, SLOTS
+from pgae_lite.phrasings import gerund
 
 #: Past participles the -ed rule gets wrong.
 _IRREGULAR = {"thrust": "thrust", "draw": "drawn", "slide": "slid", "sweep": "swept",
               "bring": "brought", "send": "sent", "take": "taken", "get": "gotten"}
-_DOUBLED = ("drag", "prod", "propel", "skid", "slip", "tug")
 
 
 def participle(verb: str) -> str:
-    """``push`` -> ``pushed``, ``glide`` -> ``glided``, ``drag`` -> ``dragged``, ``draw`` -> ``drawn``."""
-    if verb in _IRREGULAR:
-        return _IRREGULAR[verb]
-    if verb in _DOUBLED:
-        return verb + verb[-1] + "ed"
-    return verb + ("d" if verb.endswith("e") else "ed")
+    """``push`` -> ``pushed``, ``glide`` -> ``glided``, ``drag`` -> ``dragged``, ``draw`` -> ``drawn``.
+
+    The -ing form's stem (:func:`pgae_lite.phrasings.gerund`: ``dragg``, ``glid``) plus ``ed``."""
+    return _IRREGULAR.get(verb) or gerund(verb)[:-len("ing")] + "ed"
 
 
 def _action(action: str, rng: random.Random) -> tuple[str, str]:
