@@ -22,6 +22,10 @@ never trained on), and measured three ways:
   readback words executed;
 - the canonical Table 1 cells of the model on the same data.
 
+A variant trained on phrasings reads free text through its WordNet lookup
+(:mod:`pgae_lite.word_lookup`); its readback is also measured without the
+lookup (``*_no_lookup_%``), and ``looked_up`` lists the words it replaced.
+
 The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
 model's training language (the descriptions, plus the phrasings' lexicon for the
 variant). The full lexicon holds every word of the paraphrases, so that subset
@@ -143,6 +147,15 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
            "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2) if unseen.any() else None,
            "readback_wrong": [{"told": t.text, "understood": x}
                               for t, x, ok in zip(told, back.text, back.correct) if not ok][:40]}
+    lookup = getattr(model.language_encoder, "word_lookup", None)
+    if lookup is not None:    # the variant: what its WordNet lookup changed, and the readback without it
+        run["looked_up"] = dict(sorted({w: p for t in told for w, p in lookup.replacements(t.text).items()}.items()))
+        model.language_encoder.word_lookup = None
+        plain = predict(model, test, norm, "repeat language", language=model.language_encoder.encode_texts(texts))
+        model.language_encoder.word_lookup = lookup
+        run["readback_no_lookup_%"] = round(100 * plain.correct.mean(), 2)
+        if unseen.any():
+            run["readback_unseen_no_lookup_%"] = round(100 * plain.correct[unseen].mean(), 2)
     for route in ROUTES:   # "direct": the paper's execute of the sentence; "said back": its readback's words
         table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=closed, route=route,
                                     config=get_profile(profile).data, progress=False)
@@ -154,7 +167,7 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
                 if unseen.any():
                     run[f"{prefix}{loop}_success_unseen_%"] = round(100 * passed[unseen].mean(), 2)
     run["measure_seconds"] = round(time.perf_counter() - t0, 1)
-    print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1")}, flush=True)
+    print({k: v for k, v in run.items() if k not in ("readback_wrong", "table1", "looked_up")}, flush=True)
     return run
 
 

@@ -3,7 +3,7 @@
     python experiments/validation_readback.py PGAE-BERT:0 PGAE-BERT-phrasings:0 [--seed 4242] [--closed]
     python experiments/validation_readback.py PGAE-BERT-phrasings:0:input_noise=0.05
     python experiments/validation_readback.py PGAE-BERT-phrasings:1:phrasing_prob=0.5
-    python experiments/validation_readback.py PGAE-BERT-phrasings-held-out:0 --grammar second
+    python experiments/validation_readback.py PGAE-BERT-phrasings-held-out:0 --grammar second [--no-lookup]
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
 sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.phrasings`)
@@ -63,6 +63,8 @@ parser.add_argument("models", nargs="+", help="TRAINING:SEED[:OPTION=NUMBER], e.
 parser.add_argument("--seed", type=int, default=4242, help="the phrasing grammar's seed (not a training one)")
 parser.add_argument("--grammar", choices=("training", "second"), default="training",
                     help="the training grammar with another seed, or experiments/second_grammar.py's forms")
+parser.add_argument("--no-lookup", action="store_true",
+                    help="read free text without the variant's WordNet lookup (pgae_lite/word_lookup.py)")
 parser.add_argument("--closed", action="store_true", help="also execute the sentences in the closed loop")
 parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
                     help="how the closed loop reads the sentence (pgae_lite.instructions.ROUTES)")
@@ -96,6 +98,8 @@ unseen = np.array(unseen)
 for spec, (training, seed, options) in models.items():
     trained = trained_pgae(training, "book", seed, device="cpu", progress=False,
                            **{k: option_value(k, v) for k, v in options.items()})
+    if args.no_lookup and hasattr(trained.model.language_encoder, "word_lookup"):
+        trained.model.language_encoder.word_lookup = None
     heard = trained.model.language_encoder.encode_texts(texts)
     back = predict(trained.model, test, trained.normaliser, "repeat language", language=heard)
     print(f"{spec}: validation readback {100 * back.correct.mean():.2f}% "

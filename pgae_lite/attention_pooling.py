@@ -17,7 +17,9 @@ the encoder's only trained parameters. As in PGAE-BERT, the token vectors of the
 869 inputs the vocabulary allows are computed once and cached on disk; any other
 text runs through the transformer. With ``tuned=True`` (ModelConfig.tuned_top_layer),
 free text, any text outside the 869, reads the transformer's top layer trained
-(:mod:`pgae_lite.tuned_layer`) before the pooling. Used by the free-form
+(:mod:`pgae_lite.tuned_layer`) before the pooling. A training on phrasings gives
+the encoder a ``word_lookup`` (:mod:`pgae_lite.word_lookup`): free text's words
+that training never held are first looked up in WordNet. Used by the free-form
 variant ``PGAE-BERT-phrasings`` (:data:`pgae_lite.config.TRAININGS`), never by the
 paper's PGAE-BERT.
 """
@@ -30,6 +32,7 @@ from .pretrained import (Transformer, check_texts, fixed_inputs, load_transforme
                          token_vectors, tokens_to_text)
 from .tuned_layer import TunedTopLayer
 from .utils import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
+from .word_lookup import WordLookup
 
 #: Attention heads (K). Deviation from paper: chosen on generated validation sentences
 #: (experiments/validation_readback.py's grammar seed), never on the test paraphrases.
@@ -105,6 +108,8 @@ class AttentivePretrainedEncoder(nn.Module):
         # free text only: the top layer, trained (tuned_layer.py); None = frozen
         self.top = TunedTopLayer(self.transformer) if tuned else None
         self._row_of_text = {text: i for i, text in enumerate(self.texts)}
+        # set by a training on phrasings: free text's unknown words looked up first (word_lookup.py)
+        self.word_lookup: WordLookup | None = None
 
     @property
     def transformer(self) -> Transformer:
@@ -141,6 +146,8 @@ class AttentivePretrainedEncoder(nn.Module):
     def encode_texts(self, texts: list[str]) -> torch.Tensor:
         """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``."""
         texts = check_texts("encode_texts", texts)
+        if self.word_lookup is not None:                  # "the amethyst cube" -> "the purple cube"
+            texts = [self.word_lookup.rewrite(text) for text in texts]
         if self.top is None:
             return self.pool(*padded_token_vectors(self.transformer, texts))
         # a fixed input (a description, e.g. said back) reads the frozen layer's output, as in training

