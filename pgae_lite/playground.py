@@ -239,7 +239,8 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
         tensors["descriptions"][:] = torch.tensor([WORD_INDEX[w] for w in words], device=device)
     said = text or description_text(tensors["descriptions"][0, 0].cpu().numpy())   # the words the task may read
     reads_words = LANG_IN[SIGNALS.index(signal)]
-    told = input_text(signal, said if reads_words else "")
+    lookup = getattr(model.language_encoder, "word_lookup", None)   # the variant: unknown words via WordNet
+    told = input_text(signal, (lookup.rewrite(said) if lookup and text else said) if reads_words else "")
     free = bool(reads_words and text and words is None)   # PGAE-BERT reads the text as it is
     language = model.language_encoder.encode_texts([told]) if free else None
 

@@ -97,7 +97,7 @@ class WordLookup:
         """Whether ``word`` (lower case) or a base form of it is in the training language."""
         return word in self.known or "'" in word or bool(base_forms(word) & self.known)
 
-    def _evidence(self, sense) -> list[str]:
+    def evidence(self, sense) -> list[str]:
         """The training phrases one WordNet sense names (with repeats)."""
         names = [*sense.lemma_names(), *(n for s in (*sense.hypernyms(), *sense.similar_tos())
                                          for n in s.lemma_names())]
@@ -112,7 +112,7 @@ class WordLookup:
             votes, named = Counter(), {}
             for sense in wordnet().synsets(word):
                 by_slot: dict[str, dict[tuple[str, str], list[str]]] = {}
-                for phrase in self._evidence(sense):
+                for phrase in self.evidence(sense):
                     meaning = self.meaning_of[phrase]
                     by_slot.setdefault(meaning[0], {}).setdefault(meaning, []).append(phrase)
                 for meanings in by_slot.values():

@@ -23,9 +23,11 @@ from pgae_lite.language import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
 from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_parts
 from pgae_lite.pgae import PGAE
+from pgae_lite.phrase_lexicon import LEXICON
 from pgae_lite.pretrained import input_text
 from pgae_lite.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
+from pgae_lite.word_lookup import WordLookup
 
 ARRANGEMENT, ACTION = 7, 8              # cyan left, yellow right; slide the left cube fast: pattern 116
 PATTERN = 116
@@ -211,6 +213,21 @@ def test_pgae_bert_reads_free_text(toy):
     ui.route.value = "direct"
     ui.button.click()
     assert ui.message == "" and np.allclose(ui.result.joints, r.joints)
+
+
+@pytest.mark.skipif(importlib.util.find_spec("wn") is None, reason="the word lookup needs the wn package")
+def test_the_variant_shows_the_words_its_lookup_replaced(toy):
+    """A variant with a word lookup (word_lookup.py) reads, and shows, the text with its unknown words replaced."""
+    torch.manual_seed(0)
+    model = PGAE(ModelConfig(units=16, hidden=8, language_encoder="pretrained-attention",
+                             joint_feedback="predicted")).eval()
+    model.language_encoder.word_lookup = WordLookup(LEXICON)
+    normaliser = Normaliser.fit(toy.split("train"))
+    r = play(model, None, normaliser, toy, "execute", 0, 3, "hurl the azure block away", loop=None)
+    assert r.told == "execute thrust the azure block away"             # "hurl" is no word of the lexicon
+    same = play(model, None, normaliser, toy, "execute", 0, 3, "thrust the azure block away", loop=None)
+    np.testing.assert_allclose(r.joints, same.joints, atol=1e-6)
+    assert r.understood == same.understood
 
 
 # --------------------------------------------------------------------------- the widgets, driven
