@@ -146,7 +146,8 @@ class AttentivePretrainedEncoder(nn.Module):
     def encode_texts(self, texts: list[str]) -> torch.Tensor:
         """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``."""
         texts = check_texts("encode_texts", texts)
-        if self.word_lookup is not None:                  # "the amethyst cube" -> "the purple cube"
+        # Deviation from paper: unknown words looked up in WordNet first ("amethyst cube" -> "purple cube")
+        if self.word_lookup is not None:
             texts = [self.word_lookup.rewrite(text) for text in texts]
         if self.top is None:
             return self.pool(*padded_token_vectors(self.transformer, texts))

