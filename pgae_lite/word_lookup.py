@@ -20,7 +20,7 @@ WordNet sense s of w gives evidence: the names of s, of its hypernyms and of
 its similar adjectives, and the words of its definition (not the directions,
 whose small words ``up``, ``over`` mean other things in a definition). A sense
 *votes* for a meaning when its evidence names that meaning's training phrases
-and no other meaning of the same slot (action, colour or speed):
+and no other meaning of the same slot (action, colour or speed)::
 
     votes(m) = #{s in senses(w) : s names m, and no other meaning of m's slot}
     w -> the training phrase of argmax_m votes(m) that s named most often,
