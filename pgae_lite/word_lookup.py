@@ -24,6 +24,7 @@ words ``up``, ``over`` mean other things in a definition). A sense *votes* for
 the meaning of a slot its evidence names most often, if one does::
 
     said(s, slot) = phrases of the slot among names(s), else among definition(s)
+                    (for the speed, only if s is an adjective's or an adverb's sense)
     s votes for m   if m is named in said(s, slot) more often than any other meaning
     votes(m) = #{s in senses(w) : s votes for m}
     w -> the training phrase of argmax_m votes(m) that its voters named most often,
@@ -32,7 +33,8 @@ the meaning of a slot its evidence names most often, if one does::
 (``teal``, "a blue-green color": its names say cyan twice, ``bluish green``
 and ``blue green``, and green once, its hypernym; its definition's ``blue``
 is not counted. ``maroon``, "a dark purplish-red to dark brownish-red color",
-names red twice and violet once.)
+names red twice and violet once. A verb's sense says a way of moving, not the
+speed asked for: ``scoot``, "run or move very quickly", votes for no speed.)
 
 Words stay as they are when nothing votes (``cobalt``: a metal). The rule reads
 only the training lexicon and the dictionary, never a test sentence.
@@ -125,6 +127,8 @@ class WordLookup:
         names, definition = self.evidence(sense)
         voted = {}
         for slot in SLOTS:
+            if slot == "speed" and sense.pos() not in "asr":   # a speed: an adjective's or adverb's sense
+                continue
             said = [p for p in names if self.meaning_of[p][0] == slot] or \
                    [p for p in definition if self.meaning_of[p][0] == slot]     # names first
             ranked = Counter(self.meaning_of[p] for p in said).most_common(2)

@@ -60,6 +60,13 @@ def test_a_sense_votes_for_the_meaning_it_names_most(held_out):
     assert by_definition["of dark brownish to purplish red"] == {}
 
 
+def test_a_verb_votes_for_no_speed():
+    """scoot, "run or move very quickly": a way of moving, not the speed asked for; slip's verbs say slide."""
+    lookup = WordLookup(LEXICON.without("scoot", "slip"))
+    assert all(slot != "speed" for s in wordnet().synsets("scoot") for slot, _ in lookup.votes(s))
+    assert meaning(lookup, "scoot") is None and meaning(lookup, "slip") == "slide"
+
+
 def test_known_words_their_forms_and_function_words_stay(held_out):
     text = "Please, push the red cube away slowly; it must be pushed!"
     assert held_out.rewrite(text) == text                 # "must" is grape juice in WordNet: a function word
