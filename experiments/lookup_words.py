@@ -30,22 +30,23 @@ meaning = {p: m for slot in SLOTS for m, phrases in LEXICON.phrases(slot).items(
 words = [p for p in meaning if len(words_of(p)) == 1 and p not in dataset_words and p not in test_words]
 
 
-def read(lookup: WordLookup, word: str) -> str:
-    """right, wrong (with the meaning read) or kept."""
+def read(lookup: WordLookup, word: str) -> tuple[str, str | None]:
+    """(right, wrong, kept or known; the meaning the word was read as, if any)."""
     if lookup.is_known(word):
-        return "known"
+        return "known", None
     target = lookup.target(word)
     if target is None:
-        return "kept"
-    return "right" if lookup.meaning_of[target][1] == meaning[word] else f"wrong: {lookup.meaning_of[target][1]}"
+        return "kept", None
+    read_as = lookup.meaning_of[target][1]
+    return ("right" if read_as == meaning[word] else "wrong"), read_as
 
 
-held = WordLookup(training_lexicon("held-out"))
+held, held_words = WordLookup(training_lexicon("held-out")), set(held_out_words())
 settings = {"leave one out": {w: read(WordLookup(LEXICON.without(w)), w) for w in words},
-            "held out": {w: read(held, w) for w in words if w in held_out_words()}}
+            "held out": {w: read(held, w) for w in words if w in held_words}}
 for name, reads in settings.items():
-    counts = Counter(r.split(":")[0] for r in reads.values())
+    counts = Counter(outcome for outcome, _ in reads.values())
     print(f"{name}: {len(reads)} words, " + ", ".join(f"{k} {counts[k]}" for k in ("right", "wrong", "kept", "known")))
-    for outcome in ("wrong", "kept"):
-        print(f"  {outcome}:", ", ".join(f"{w} ({meaning[w]}{r[len(outcome) + 1:] and ' ->' + r[len(outcome) + 1:]})"
-                                         for w, r in reads.items() if r.startswith(outcome)))
+    print("  wrong:", ", ".join(f"{w} ({meaning[w]} -> {read_as})" for w, (outcome, read_as) in reads.items()
+                                if outcome == "wrong"))
+    print("  kept:", ", ".join(f"{w} ({meaning[w]})" for w, (outcome, _) in reads.items() if outcome == "kept"))
