@@ -6,7 +6,7 @@
 Each ablation changes one thing of the profile's recipe (``book``), exactly as its
 exercise's solution does, and trains PGAE on our simulated data (the
 chapter's data) once per seed; the recipe itself (``recipe``, the cached
-:func:`pgae_lite.pipeline.trained_pgae`) is the baseline, on the same seeds.
+:func:`pgae_lite.runs.pipeline.trained_pgae`) is the baseline, on the same seeds.
 Writes every model's Table 1 cells and training time to
 results/ablations.json, so a solution can say whether its effect exceeds the
 spread of the seeds. With ``--workers N`` N models train side by side, each in
@@ -24,12 +24,12 @@ import torch
 from torch import nn
 
 from harness import Benchmark, side_by_side
-from pgae_lite import language
+from pgae_lite.world import words as language
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
-from pgae_lite.pgae import PGAE
-from pgae_lite.pipeline import simulated_dataset, trained_pgae
-from pgae_lite.train import train
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.train.loop import train
 
 #: ex-pgae-no-both: the signals without "repeat both" (describe, execute, repeat action, -, repeat language)
 NO_BOTH = (3 / 8, 3 / 8, 1 / 8, 0.0, 1 / 8)

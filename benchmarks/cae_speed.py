@@ -34,7 +34,7 @@ from pgae_lite.cae import (
     train_cae,
 )
 from pgae_lite.config import get_profile
-from pgae_lite.utils import default_device
+from pgae_lite.util.storage import default_device
 
 COLOURS = [(200, 35, 30), (40, 170, 50), (35, 60, 205), (225, 210, 40), (40, 200, 215), (150, 45, 190)]
 

@@ -5,14 +5,14 @@
                                      [--set plan_weight=1 epochs=200]
 
 For each training and seed, the profile's recipe model on our simulated data
-(:func:`pgae_lite.pipeline.trained_pgae`: trained once, then cached) executes
-each test episode twice (:func:`pgae_lite.closedloop.compare`): open loop, the
+(:func:`pgae_lite.runs.pipeline.trained_pgae`: trained once, then cached) executes
+each test episode twice (:func:`pgae_lite.robot.closedloop.compare`): open loop, the
 paper's execute (the decoder reads the recorded vision), and closed loop (it
 reads what its own motion shows). Prints the success rate per action and
 speed and the time per episode; writes the success rates, their gap and every
 failed closed-loop episode to results/closed_loop.json, with the model's Table 1
 cells on the same data (:func:`pgae_lite.evaluate.evaluate`) and whether its h says
-which cube to move (:func:`pgae_lite.plan.which_cube_probe`; ``PGAE-no-plan`` is the
+which cube to move (:func:`pgae_lite.model.plan.which_cube_probe`; ``PGAE-no-plan`` is the
 recipe without the plan head). ``--limit N`` takes N
 episodes evenly spread over the 216 of the test split. The models are small:
 one thread is as fast as two, so ``--workers N`` trains and runs N models side by
@@ -29,12 +29,12 @@ import time
 import torch
 
 from harness import Benchmark, key_value, side_by_side
-from pgae_lite.closedloop import compare, success_summary
+from pgae_lite.robot.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
-from pgae_lite.errors import ArgumentError
+from pgae_lite.util.errors import ArgumentError
 from pgae_lite.evaluate import evaluate
-from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.plan import which_cube_probe
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.model.plan import which_cube_probe
 
 
 @functools.cache

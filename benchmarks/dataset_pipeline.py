@@ -25,8 +25,8 @@ def main() -> None:
     os.environ["PGAE_LITE_CACHE"] = args.cache or tempfile.mkdtemp(prefix="pgae-cache-")
 
     from pgae_lite.config import get_profile                   # after the cache is set
-    from pgae_lite.pipeline import simulated_dataset, trained_cae
-    from pgae_lite.simdata import generate
+    from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
+    from pgae_lite.data.simulated import generate
 
     row = {"cache": os.environ["PGAE_LITE_CACHE"], "workers": args.workers}
     t0 = time.perf_counter()

@@ -3,7 +3,7 @@
     python benchmarks/device_epoch.py [--data PATH] [--profile paper] [--epochs 3]
                                       [--batches 6 16] [--devices cpu cuda] [--threads 2]
 
-Trains the PGAE row on the authors' data with :func:`pgae_lite.train.train`, unchanged, for
+Trains the PGAE row on the authors' data with :func:`pgae_lite.train.loop.train`, unchanged, for
 ``--epochs`` epochs of the profile (default ``paper``: peephole cells, one LSTM step per time
 step, Adam 1e-5) at each batch size (default: the paper's 6 and the book recipe's), on each
 device (default: the CPU, and CUDA where torch sees it). The first epoch is reported apart
@@ -18,8 +18,8 @@ import torch
 
 from harness import Benchmark
 from pgae_lite.config import get_profile
-from pgae_lite.original import load_original
-from pgae_lite.train import train
+from pgae_lite.data.original import load_original
+from pgae_lite.train.loop import train
 
 
 def epoch_seconds(dataset, profile, device: str) -> list[float]:

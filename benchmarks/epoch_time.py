@@ -4,7 +4,7 @@
                                     [--data PATH] [--epochs 3] [--rounds 2] [--threads 1]
 
 On the authors' data (648 training samples), with the real training loop
-(:func:`pgae_lite.train.train`). A candidate is one or more options of the
+(:func:`pgae_lite.train.loop.train`). A candidate is one or more options of the
 recipe's model (:class:`~pgae_lite.config.ModelConfig`) or training
 (:class:`~pgae_lite.config.TrainConfig`), ``KEY=VALUE`` joined by commas. Each
 setting trains ``--epochs`` epochs (the first, a warm-up, is not counted); the
@@ -22,8 +22,8 @@ from dataclasses import fields, replace
 
 from harness import Benchmark, key_value
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
-from pgae_lite.original import load_original
-from pgae_lite.train import train
+from pgae_lite.data.original import load_original
+from pgae_lite.train.loop import train
 
 MODEL_OPTIONS = {f.name for f in fields(ModelConfig)}
 TRAIN_OPTIONS = {f.name for f in fields(TrainConfig)} - {"epochs", "seed", "max_train_samples"}

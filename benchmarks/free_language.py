@@ -8,7 +8,7 @@
 Both models are trained (or loaded from the cache) on the profile's simulated
 data: ``PGAE-BERT`` reads the dataset's descriptions only; ``PGAE-BERT-phrasings``
 also reads generated sentences that say them in other words
-(:mod:`pgae_lite.phrasing_bank`). Each of the 216 test episodes is told one of
+(:mod:`pgae_lite.bert.phrasing_bank`). Each of the 216 test episodes is told one of
 the 108 held-out paraphrases of its instruction (``pgae_lite/paraphrases.tsv``,
 never trained on), and measured three ways:
 
@@ -17,20 +17,20 @@ never trained on), and measured three ways:
 - *execution*: the paraphrase with ``execute`` in the simulator, open loop (the
   decoder reads the recorded frames of the right action: it overstates
   understanding) and closed loop (its own camera); by two routes
-  (:data:`pgae_lite.instructions.ROUTES`): ``direct``, the paper's, the sentence's
+  (:data:`pgae_lite.robot.instructions.ROUTES`): ``direct``, the paper's, the sentence's
   features into execute; ``said back`` (``said_back_*`` keys), the model's
   readback words executed;
 - the canonical Table 1 cells of the model on the same data.
 
 A variant trained on phrasings reads free text through its WordNet lookup
-(:mod:`pgae_lite.word_lookup`); its readback is also measured without the
+(:mod:`pgae_lite.bert.word_lookup`); its readback is also measured without the
 lookup (``*_no_lookup_%``), and ``looked_up`` lists the words it replaced.
 
 The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
 model's training language (the descriptions, plus the phrasings' lexicon for the
 variant). The full lexicon holds every word of the paraphrases, so that subset
 is measured with ``PGAE-BERT-phrasings-held-out``, trained without the words of
-:func:`pgae_lite.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
+:func:`pgae_lite.bert.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
 Writes results/free_language.json.
 
 With ``--original`` it measures only the canonical Table 1 of each training on
@@ -54,18 +54,18 @@ import numpy as np
 import torch
 
 from harness import Benchmark, side_by_side
-from pgae_lite.closedloop import variation_of
+from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.config import TRAININGS, get_profile, training_profile
 from pgae_lite.evaluate import evaluate, predict
-from pgae_lite.instructions import ROUTES, execute_paraphrases, paraphrase_of
-from pgae_lite.language import SIGNALS, VOCABULARY
-from pgae_lite.original import load_original
-from pgae_lite.paraphrases import load_paraphrases
-from pgae_lite.phrase_lexicon import training_lexicon
-from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.pretrained import input_text, load_transformer
-from pgae_lite.train import train
-from pgae_lite.utils import CACHE_ENV
+from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
+from pgae_lite.world.words import SIGNALS, VOCABULARY
+from pgae_lite.data.original import load_original
+from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.bert.phrase_lexicon import training_lexicon
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.bert.pretrained import input_text, load_transformer
+from pgae_lite.train.loop import train
+from pgae_lite.util.storage import CACHE_ENV
 
 
 def words(text: str) -> set[str]:

@@ -13,7 +13,7 @@
         main()
 
 The work runs under the ``__main__`` guard: recording the simulated data
-(:func:`pgae_lite.simdata.generate`, which :func:`pgae_lite.pipeline.simulated_dataset`
+(:func:`pgae_lite.data.simulated.generate`, which :func:`pgae_lite.runs.pipeline.simulated_dataset`
 and ``trained_cae`` call when the cache lacks it) spawns worker processes, and
 each re-imports the script; unguarded, they would run the benchmark again.
 
@@ -25,7 +25,7 @@ A result file is JSON::
      "profile": "book", "seeds": [0, 1, 2], "seconds": 1234.5, "data": {...}}
 
 ``data`` is whatever the benchmark measured; the book, the README and the
-tests read every quoted figure from these files (:mod:`pgae_lite.results`).
+tests read every quoted figure from these files (:mod:`pgae_lite.runs.results`).
 Files are written atomically, NaN refused (``allow_nan=False``): a result is
 valid JSON or is not written.
 """
@@ -112,7 +112,7 @@ class Benchmark:
 
     def write(self, data: dict, **fields) -> Path:
         """``data`` with the command, commit, date and machine, to :attr:`path` (atomically)."""
-        from pgae_lite.utils import atomic_write_text     # here: torch loads only when a result is written
+        from pgae_lite.util.storage import atomic_write_text     # here: torch loads only when a result is written
 
         args = self.args or argparse.Namespace(profile=None, seeds=None, threads=None)
         report = {"benchmark": self.name,

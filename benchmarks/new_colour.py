@@ -1,7 +1,7 @@
 """Teach NICO a new colour, end to end: record, retrain the CAE and PGAE, check.
 
 Runs every step of the book's guided project (appendix A3) once and times it:
-the new episodes (pgae_lite.extended.record), the CAE on old + new frames, the
+the new episodes (pgae_lite.runs.new_colour.record), the CAE on old + new frames, the
 features of every episode, PGAE built for the enlarged vocabulary, and
 pgae_lite.exercises.check_new_colour on the held-out episodes. It also writes
 Table 1's cells on the paper's 36 test patterns and on the new ones, and the
@@ -21,7 +21,7 @@ import time
 import numpy as np
 from harness import Benchmark
 
-from pgae_lite.world import with_colour
+from pgae_lite.world.colours import with_colour
 
 
 def reference_errors(data) -> dict:
@@ -64,7 +64,7 @@ def main() -> None:
 
     import torch
 
-    from pgae_lite import extended
+    from pgae_lite.runs import new_colour as extended
     from pgae_lite.evaluate import evaluate
     from pgae_lite.exercises import check_new_colour
 

@@ -8,7 +8,7 @@ natural language". Here every test episode is told one of the 108 held-out
 paraphrases of its own instruction (``pgae_lite/paraphrases.tsv``, e.g. "Could
 you shove the crimson cube forward in a hurry"; episode variation v gets the
 paraphrase v mod 3 of its meaning, so each is used twice over the 216 episodes)
-and executes it (:func:`pgae_lite.instructions.execute_paraphrases`): open loop,
+and executes it (:func:`pgae_lite.robot.instructions.execute_paraphrases`): open loop,
 the paper's execute (the decoder reads the recorded vision), and closed loop
 (it reads what its own motion shows). Success is the simulator's check that
 the named cube moved the named way; nRMSE is against the recorded joints of the
@@ -27,12 +27,12 @@ from __future__ import annotations
 import time
 
 from harness import Benchmark
-from pgae_lite.closedloop import success_summary
+from pgae_lite.robot.closedloop import success_summary
 from pgae_lite.config import get_profile
-from pgae_lite.instructions import execute_paraphrases
-from pgae_lite.language import LanguageError
-from pgae_lite.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.train import load_model
+from pgae_lite.robot.instructions import execute_paraphrases
+from pgae_lite.world.words import LanguageError
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.train.loop import load_model
 
 
 def main() -> None:

@@ -5,7 +5,7 @@
 On the authors' data (648 training samples; our simulated data has the same
 shapes), with the book recipe's model and training options, for each batch
 size: one warm-up epoch, then ``--epochs`` timed epochs of the real training
-loop (:func:`pgae_lite.train.train`), once in float32 and once under CPU
+loop (:func:`pgae_lite.train.loop.train`), once in float32 and once under CPU
 autocast to bfloat16 (``torch.autocast``: the LSTMs' and linear layers' matmuls
 in bfloat16; the training options have no switch for it, since it did not pay
 at the recipe's batch). Reports
@@ -32,11 +32,11 @@ from torch.profiler import ProfilerActivity, profile
 
 from harness import Benchmark
 from pgae_lite.config import get_profile
-from pgae_lite.data import JOINT_DIM, VISION_DIM
-from pgae_lite.language import INPUT_DIM, VOCABULARY
-from pgae_lite.original import load_original
-from pgae_lite.signals import ACTION_IN, LANG_IN, SIGNAL_PROBS
-from pgae_lite.train import train
+from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
+from pgae_lite.world.words import INPUT_DIM, VOCABULARY
+from pgae_lite.data.original import load_original
+from pgae_lite.model.signals import ACTION_IN, LANG_IN, SIGNAL_PROBS
+from pgae_lite.train.loop import train
 
 bench = Benchmark("profile_epoch", __doc__)
 bench.parser.add_argument("--data", default="../shared/pgae-original-data")

@@ -8,8 +8,8 @@ Small read-outs (logistic regression, and an MLP with one hidden layer) learn
 input PGAE-BERT's GMU gets. They are trained either on the dataset's 288
 descriptions (each meaning's 8 synonym variants: the ``canonical`` baseline)
 or on those plus ``--per-meaning`` generated phrasings of each of the 36
-meanings (pgae_lite.phrasings, a new set per seed: ``augmented``). Accuracy
-(all three right) on the 108 held-out paraphrases (pgae_lite.paraphrases),
+meanings (pgae_lite.bert.phrasings, a new set per seed: ``augmented``). Accuracy
+(all three right) on the 108 held-out paraphrases (pgae_lite.bert.paraphrases),
 on those with a word no augmented training sentence has (``new_word``), and
 on those where some slot says its meaning with none of the lexicon phrases
 the augmented training sentences used for that meaning (``new_slot_phrase``).
@@ -28,12 +28,12 @@ import random
 import torch
 from harness import Benchmark
 
-from pgae_lite.language import (ACTIONS, COLOURS, SPEEDS, SYNONYMS,
+from pgae_lite.world.words import (ACTIONS, COLOURS, SPEEDS, SYNONYMS,
                                  equivalent_descriptions)
-from pgae_lite.paraphrases import load_paraphrases
-from pgae_lite.phrase_lexicon import LEXICON, SLOTS, words_of
-from pgae_lite.phrasings import gerund, phrasings
-from pgae_lite.pretrained import PretrainedLanguageEncoder, input_text
+from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.bert.phrase_lexicon import LEXICON, SLOTS, words_of
+from pgae_lite.bert.phrasings import gerund, phrasings
+from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, input_text
 
 MEANINGS = list(itertools.product(ACTIONS, COLOURS, SPEEDS))
 MEANING_OF = dict(zip(SLOTS, (ACTIONS, COLOURS, SPEEDS)))

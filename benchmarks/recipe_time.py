@@ -19,8 +19,8 @@ from dataclasses import replace
 from harness import Benchmark
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
-from pgae_lite.original import load_original
-from pgae_lite.train import train
+from pgae_lite.data.original import load_original
+from pgae_lite.train.loop import train
 
 #: The recipe before (1,200 epochs, at f994b81): what it changes in today's book recipe, its training and model
 #: (batches of any length, one LSTM step per time step, the paper's GMU, no plan head).

@@ -27,7 +27,7 @@ import numpy as np
 
 from harness import Benchmark
 from pgae_lite.config import get_profile
-from pgae_lite.patterns import Pattern, pattern_number
+from pgae_lite.world.patterns import Pattern, pattern_number
 from pgae_lite.sim import SimConfig, Simulation, record_episode
 
 

@@ -22,8 +22,8 @@ from pathlib import Path
 
 from pgae_lite.config import ROWS
 from pgae_lite.evaluate import PAPER_TABLE
-from pgae_lite.language import TEST_SIGNALS
-from pgae_lite.reproduce import parse_rows
+from pgae_lite.world.words import TEST_SIGNALS
+from pgae_lite.runs.reproduce import parse_rows
 
 from harness import Benchmark
 

@@ -14,9 +14,9 @@ from dataclasses import replace
 
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
-from pgae_lite.original import load_original
-from pgae_lite.pipeline import simulated_dataset
-from pgae_lite.train import train
+from pgae_lite.data.original import load_original
+from pgae_lite.runs.pipeline import simulated_dataset
+from pgae_lite.train.loop import train
 
 
 def overrides(pairs):
@@ -49,7 +49,7 @@ def main() -> None:
         if epoch % a.every and epoch != a.epochs:
             return
         t = time.perf_counter() - t0
-        from pgae_lite.data import Normaliser
+        from pgae_lite.data.dataset import Normaliser
         norm = Normaliser.fit(ds.split("train"), prof.train.vision_scaling)
         res, _ = evaluate(model, ds, norm)
         line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},

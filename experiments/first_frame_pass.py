@@ -12,7 +12,7 @@ a second time from the same h reading only the first frame, v_0, at every step, 
 
 ``--detach`` holds the decoder's weights fixed in that pass, so its gradient reaches h only.
 With ``--sim --save DIR`` it then runs ``episodes`` test episodes open and closed loop
-(:func:`pgae_lite.closedloop.compare`). It patches the training loop, which is why it is an
+(:func:`pgae_lite.robot.closedloop.compare`). It patches the training loop, which is why it is an
 experiment and not an option of the package.
 """
 import argparse
@@ -21,9 +21,9 @@ from pathlib import Path
 
 import torch
 
-import pgae_lite.train as training
-from pgae_lite.pgae import PGAE
-from pgae_lite.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH
+import pgae_lite.train.loop as training
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH
 
 sys.path.insert(0, str(Path(__file__).parent))
 import explore_recipe  # noqa: E402
@@ -76,8 +76,8 @@ def main() -> None:
     sys.argv = [sys.argv[0], *rest]
     explore_recipe.main()
     if "--sim" in rest and "--save" in rest:
-        from pgae_lite.closedloop import compare, success_summary
-        from pgae_lite.pipeline import simulated_dataset, trained_cae
+        from pgae_lite.robot.closedloop import compare, success_summary
+        from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
         data = simulated_dataset("book", progress=False)
         cae, _ = trained_cae("book", progress=False)
         folder = Path(rest[rest.index("--save") + 1])

@@ -3,7 +3,7 @@
     python experiments/recorded_first_steps.py CHECKPOINT [--episodes 24] [--steps 0 6 12 20 30]
 
 Runs test episodes of our simulated data (book profile) in closed loop, as
-:func:`pgae_lite.closedloop.closed_loop` does, except that for the first K time
+:func:`pgae_lite.robot.closedloop.closed_loop` does, except that for the first K time
 steps the decoder reads the *recorded* frame instead of its own camera's (the
 arm still moves as the model says). If success jumps once K covers the first
 steps, the decoder decides in those steps what it does later: which cube it
@@ -17,11 +17,11 @@ import numpy as np
 import torch
 
 from pgae_lite.cae import extract_features
-from pgae_lite.closedloop import _drive, _simulation, _start, execute_batch, spread, variation_of
+from pgae_lite.robot.closedloop import _drive, _simulation, _start, execute_batch, spread, variation_of
 from pgae_lite.config import PROFILES
-from pgae_lite.data import description_text
-from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.train import load_model
+from pgae_lite.data.dataset import description_text
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
+from pgae_lite.train.loop import load_model
 
 
 @torch.no_grad()

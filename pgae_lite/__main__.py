@@ -7,7 +7,7 @@ prints the table next to the paper's rows and writes ``results.json`` and
 ``predictions.npz`` to the output folder. ``simulate`` records the dataset.
 
 Every argument is checked before any data is read. A bad one, or any error of
-the package (:class:`~pgae_lite.errors.PGAELiteError`), prints one line
+the package (:class:`~pgae_lite.util.errors.PGAELiteError`), prints one line
 ``error: ...`` and exits with status 2, without a traceback.
 """
 from __future__ import annotations
@@ -28,8 +28,8 @@ ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
 
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
     """Record the profile's simulated dataset (or complete it) and print what was done."""
-    from .config import get_profile
-    from .simdata import generate
+    from pgae_lite.config import get_profile
+    from pgae_lite.data.simulated import generate
 
     report = generate(get_profile(profile).data, workers=workers, progress=progress)
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
@@ -85,7 +85,7 @@ def main(argv: list[str] | None = None) -> int:
                      help="parallel processes, at least 1 (default: one per CPU core)")
     sim.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
-    from .errors import ArgumentError, PGAELiteError
+    from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
     try:
         return run_command(args)
@@ -98,9 +98,9 @@ def main(argv: list[str] | None = None) -> int:
 
 def run_command(args: argparse.Namespace) -> int:
     """Check the parsed arguments (before any data is read), then run the command."""
-    from .config import profile_name
-    from .errors import ArgumentError
-    from .validate_api import whole_number
+    from pgae_lite.config import profile_name
+    from pgae_lite.util.errors import ArgumentError
+    from pgae_lite.util.checks import whole_number
 
     try:                      # --profile is checked by argparse; this checks the environment variable too
         profile = profile_name(args.profile)
@@ -111,7 +111,7 @@ def run_command(args: argparse.Namespace) -> int:
         if args.workers is not None:
             whole_number("--workers", args.workers, 1)
         return simulate(profile, args.workers, not args.no_progress)
-    from .reproduce import check_arguments, reproduce
+    from pgae_lite.runs.reproduce import check_arguments, reproduce
 
     original = args.original_data
     if original is None and ORIGINAL_DATA_ENV in os.environ:

@@ -36,7 +36,7 @@ from torch import nn
 from torch.nn.utils.fusion import fuse_conv_bn_eval
 from tqdm.auto import tqdm
 
-from .utils import CheckpointMismatchError, default_device, load_torch, save_torch, training_threads
+from pgae_lite.util.storage import CheckpointMismatchError, default_device, load_torch, save_torch, training_threads
 
 HEIGHT, WIDTH = 120, 160
 COLOURS = ("red", "green", "blue")
@@ -226,7 +226,7 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
 
     Batches are drawn without replacement from a seeded shuffle (a new one each
     pass over the data), and on the CPU it runs on a fixed number of torch threads
-    (:func:`~pgae_lite.utils.training_threads`), so a seed gives the same weights bit for
+    (:func:`~pgae_lite.util.storage.training_threads`), so a seed gives the same weights bit for
     bit on the same kind of device, whatever the caller's thread count. History: one record per
     iteration, ``{"iteration", "loss", "red", "green", "blue"}`` (BCE).
 
@@ -292,7 +292,7 @@ def load_cae(path: str | Path, device: torch.device | str | None = None) -> tupl
     """A trained CAE (in eval mode) and its checkpoint's other contents.
 
     Read with ``weights_only=True``; a damaged or foreign file raises
-    :class:`~pgae_lite.utils.CorruptCheckpointError`.
+    :class:`~pgae_lite.util.storage.CorruptCheckpointError`.
     """
     ckpt = load_torch(path, ("model", "config", "data", "history"), "CAE checkpoint")
     model = ChannelSeparatedCAE(CAEConfig.from_dict(ckpt["config"]))

@@ -1,6 +1,6 @@
 """Profiles and recipes, in one place: the paper's Sec. 4 training settings and Table 1's rows.
 
-A profile is a whole run: what to record (:class:`~pgae_lite.simdata.DatasetConfig`),
+A profile is a whole run: what to record (:class:`~pgae_lite.data.simulated.DatasetConfig`),
 the CAE (:class:`~pgae_lite.cae.CAEConfig`), the model (:class:`ModelConfig`), its
 training (:class:`TrainConfig`) and how much the chapters do (:class:`ChapterSettings`).
 Three are built in:
@@ -21,13 +21,13 @@ from __future__ import annotations
 import os
 from dataclasses import asdict, dataclass, field, replace
 
-from .cae import CAEConfig
-from .data import check_vision_scaling
-from .errors import ArgumentError
-from .language import SIGNALS
-from .patterns import pattern_number
-from .signals import SIGNAL_PROBS
-from .simdata import DatasetConfig
+from pgae_lite.cae import CAEConfig
+from pgae_lite.data.dataset import check_vision_scaling
+from pgae_lite.util.errors import ArgumentError
+from pgae_lite.world.words import SIGNALS
+from pgae_lite.world.patterns import pattern_number
+from pgae_lite.model.signals import SIGNAL_PROBS
+from pgae_lite.data.simulated import DatasetConfig
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
@@ -46,7 +46,7 @@ LEGACY_MODEL_SETTINGS = {"joint_feedback": "predicted", "time_stride": 1, "gmu_n
 
 @dataclass
 class ModelConfig:
-    """Architecture of PGAE (:class:`pgae_lite.pgae.PGAE`). Defaults are the ``book`` recipe.
+    """Architecture of PGAE (:class:`pgae_lite.model.pgae.PGAE`). Defaults are the ``book`` recipe.
 
     Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50.
     """
@@ -264,7 +264,7 @@ def profile_name(name: str | None = None) -> str:
     """``name``, else ``$PGAE_LITE_PROFILE``, else ``"book"``: the name of a built-in profile.
 
     The only code that reads the environment variable. An unknown name (or not a string)
-    raises an :class:`~pgae_lite.errors.ArgumentError` (a ``ValueError``) that lists the
+    raises an :class:`~pgae_lite.util.errors.ArgumentError` (a ``ValueError``) that lists the
     profiles (and names the variable if it came from there).
     """
     where = ""

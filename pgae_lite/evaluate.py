@@ -18,13 +18,13 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from .data import Normaliser, PGAEDataset
-from .errors import ArgumentError
-from .language import (DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, decode, is_correct,
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.util.errors import ArgumentError
+from pgae_lite.world.words import (DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, decode, is_correct,
                        normalise_signal)
-from .pgae import PGAE
-from .signals import LANG_OUT, make_batch, signal_ids
-from .validate_api import instance_of, positive_number, whole_number
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.model.signals import LANG_OUT, make_batch, signal_ids
+from pgae_lite.util.checks import instance_of, positive_number, whole_number
 
 #: The paper's Table 1: (accuracy %, nRMSE %) per row and signal.
 PAPER_TABLE: dict[str, dict[str, tuple[float, float]]] = {
@@ -69,7 +69,7 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
     ``tensors``: ``normaliser.tensors(data, device)`` when the caller has them already.
     ``language`` (N, D): precomputed language features, one row per sample, in place of
     the language encoder's (``model(batch, language=...)``), e.g. free text through
-    :func:`pgae_lite.instructions.instruction_features`: with ``"execute"`` the paper's
+    :func:`pgae_lite.robot.instructions.instruction_features`: with ``"execute"`` the paper's
     execute (open loop: the recorded vision at every step) of those instructions.
     """
     check_model_inputs(model, data, normaliser)

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data import Normaliser
-from pgae_lite.original import load_original
-from pgae_lite.toydata import toy_dataset
+from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.original import load_original
+from pgae_lite.data.toy import toy_dataset
 
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 CACHE_ENV = "PGAE_LITE_CACHE"
@@ -90,7 +90,7 @@ def _private_cache(tmp_path_factory):
 def smoke_episodes(_private_cache):
     """The smoke profile's simulated dataset (24 episodes), recorded once per session."""
     from pgae_lite.config import get_profile
-    from pgae_lite.simdata import generate
+    from pgae_lite.data.simulated import generate
 
     config = get_profile("smoke").data
     return config, generate(config, progress=False)
@@ -114,7 +114,7 @@ def set_threads():
 def interrupt_training():
     """``interrupt_training(dataset, profile, out_dir, epoch)``: ``train`` stopped by an exception raised
     from its callback at ``epoch``, as if the process were killed there (to test resuming)."""
-    from pgae_lite.train import train
+    from pgae_lite.train.loop import train
 
     class Interrupt(Exception):
         pass

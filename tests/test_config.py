@@ -6,7 +6,7 @@ import pytest
 from pgae_lite.cae import CAEConfig
 from pgae_lite.config import (PROFILE_ENV, PROFILE_NAMES, PROFILES, SMOKE_PATTERNS, ChapterSettings, Profile,
                               get_profile, profile_name)
-from pgae_lite.simdata import DatasetConfig
+from pgae_lite.data.simulated import DatasetConfig
 
 UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
 
@@ -64,14 +64,14 @@ def test_get_profile_copies():
 
 
 def test_recipes_live_here():
-    import pgae_lite.reproduce
+    import pgae_lite.runs.reproduce
     from pgae_lite.config import ROWS, TRAININGS, training_profile
 
     assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-no-plan", "PGAE-views", "PGAE-BERT-phrasings",
                               "PGAE-BERT-phrasings-held-out"]
     assert training_profile(get_profile("book"), "PGAE-no-plan").model.plan_keyframes == 0
     assert {training for training, _ in ROWS.values()} <= set(TRAININGS)
-    assert pgae_lite.reproduce.TRAININGS is TRAININGS and pgae_lite.reproduce.ROWS is ROWS
+    assert pgae_lite.runs.reproduce.TRAININGS is TRAININGS and pgae_lite.runs.reproduce.ROWS is ROWS
     smoke = get_profile("smoke")
     bert = training_profile(smoke, "PGAE-BERT", pretrained_model="bert-base-uncased")
     assert bert.model.language_encoder == "pretrained" and bert.model.pretrained_model == "bert-base-uncased"
@@ -82,7 +82,7 @@ def test_recipes_live_here():
 
 def test_gmu_norm_is_the_book_recipe_and_not_the_papers():
     from pgae_lite.config import ModelConfig, get_profile
-    from pgae_lite.pgae import PGAE
+    from pgae_lite.model.pgae import PGAE
     assert ModelConfig().gmu_norm and get_profile("book").model.gmu_norm
     assert not get_profile("paper").model.gmu_norm
     assert PGAE(ModelConfig(units=8)).gmu.normalise_action

@@ -1,4 +1,4 @@
-"""pgae_lite.data: the dataset type, its split, saving and loading, normalisation."""
+"""pgae_lite.data.dataset: the dataset type, its split, saving and loading, normalisation."""
 from __future__ import annotations
 
 import json
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data import Normaliser, PGAEDataset, whitening
-from pgae_lite.patterns import MAX_STEPS, Pattern
+from pgae_lite.data.dataset import Normaliser, PGAEDataset, whitening
+from pgae_lite.world.patterns import MAX_STEPS, Pattern
 
 
 # --------------------------------------------------------------------------- the dataset
@@ -115,8 +115,8 @@ def test_subset_and_mask(toy):
 
 
 def test_dataset_save_load_round_trip_and_damage(tmp_path):
-    from pgae_lite.data import DataFormatError, PGAEDataset
-    from pgae_lite.toydata import toy_dataset
+    from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+    from pgae_lite.data.toy import toy_dataset
 
     ds = toy_dataset()
     path = tmp_path / "ds.npz"

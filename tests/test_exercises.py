@@ -11,9 +11,9 @@ from torch import nn
 from pgae_lite.config import get_profile
 from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu, check_lstm_step,
                                  check_peephole_step, check_signal_probs, check_vocabulary)
-from pgae_lite.language import VOCABULARY
-from pgae_lite.layers import GatedMultimodalUnit
-from pgae_lite.train import train
+from pgae_lite.world.words import VOCABULARY
+from pgae_lite.model.layers import GatedMultimodalUnit
+from pgae_lite.train.loop import train
 
 
 def failed_with(result: CheckResult, *phrases: str) -> bool:

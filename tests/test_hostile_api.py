@@ -22,22 +22,22 @@ from hypothesis import strategies as st
 
 import pgae_lite
 from pgae_lite.config import PROFILE_ENV, get_profile, profile_name
-from pgae_lite.data import Normaliser
-from pgae_lite.errors import ArgumentError, ArgumentTypeError, PGAELiteError
+from pgae_lite.data.dataset import Normaliser
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError, PGAELiteError
 from pgae_lite.evaluate import Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.config import ModelConfig
-from pgae_lite.instructions import instruction_features
-from pgae_lite.language import (BOS_EOS, SLOTS, SYNONYMS, VOCABULARY, LanguageError,
+from pgae_lite.robot.instructions import instruction_features
+from pgae_lite.world.words import (BOS_EOS, SLOTS, SYNONYMS, VOCABULARY, LanguageError,
                                 decode, encode, one_hot, parse_description)
-from pgae_lite.pgae import PGAE
-from pgae_lite.pipeline import simulated_dataset
-from pgae_lite.playground import (PlayResult, Playground, action_label,
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.runs.pipeline import simulated_dataset
+from pgae_lite.robot.playground import (PlayResult, Playground, action_label,
                                   arrangement_label, find_episode, pattern_number, play,
                                   simulator_config)
-from pgae_lite.pretrained import PretrainedLanguageEncoder, load_transformer
-from pgae_lite.patterns import ARRANGEMENTS
-from pgae_lite.reproduce import reproduce, write_results
-from pgae_lite.validate_playground import LAST_PATTERN
+from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, load_transformer
+from pgae_lite.world.patterns import ARRANGEMENTS
+from pgae_lite.runs.reproduce import reproduce, write_results
+from pgae_lite.robot.playground_checks import LAST_PATTERN
 from test_cli import run as run_cli
 
 WORDS = [w for w in VOCABULARY if w != BOS_EOS]

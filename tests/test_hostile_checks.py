@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu,
                                  check_lstm_step, check_peephole_step, check_signal_probs)
-from pgae_lite.layers import GatedMultimodalUnit
+from pgae_lite.model.layers import GatedMultimodalUnit
 
 ORANGE = (0.98, 0.5, 0.05, 1.0)
 

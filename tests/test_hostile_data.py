@@ -27,18 +27,18 @@ from test_original import SUBTREES, _fake_tree
 from test_train import tiny_profile
 
 import pgae_lite
-from pgae_lite import pipeline
+from pgae_lite.runs import pipeline
 from pgae_lite.cae import load_cae
 from pgae_lite.config import TrainConfig, get_profile
-from pgae_lite.data import DataFormatError, PGAEDataset
-from pgae_lite.language import VOCABULARY
-from pgae_lite.original import load_original
-from pgae_lite.pgae import PGAE
-from pgae_lite.simdata import (CorruptEpisodeError, episode_folder, generate,
+from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+from pgae_lite.world.words import VOCABULARY
+from pgae_lite.data.original import load_original
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.data.simulated import (CorruptEpisodeError, episode_folder, generate,
                                load_episode_file)
-from pgae_lite.train import (CHECKPOINT, NonFiniteLossError, load_checkpoint,
+from pgae_lite.train.loop import (CHECKPOINT, NonFiniteLossError, load_checkpoint,
                              load_model, train)
-from pgae_lite.utils import (LOCK_FILE, CorruptCheckpointError, FolderBusyError,
+from pgae_lite.util.storage import (LOCK_FILE, CorruptCheckpointError, FolderBusyError,
                              OutputError, atomic_write_text, save_torch)
 
 SAMPLE = Path("201207") / "target000000.txt"     # pattern 0: training, 100 steps
@@ -279,7 +279,7 @@ def test_a_checkpoint_lacking_keys_is_named(tmp_path):
 _FULL = textwrap.dedent("""
     import resource, signal, sys, torch
     from pathlib import Path
-    from pgae_lite.utils import OutputError, save_torch
+    from pgae_lite.util.storage import OutputError, save_torch
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)      # a write past it fails instead
     resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
     try:

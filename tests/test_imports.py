@@ -89,11 +89,11 @@ def reachable(name: str) -> set[str]:
 
 
 def test_the_graph_is_read():
-    assert GRAPH["pgae_lite.train"] >= {"pgae_lite.config", "pgae_lite.pgae", "pgae_lite.utils"}
-    assert "pgae_lite.train" in GRAPH["pgae_lite.pipeline"]           # a function-level import counts
-    assert "pgae_lite.language" in GRAPH["pgae_lite.sim.actions"]      # from ..language
-    assert "pgae_lite.sim" in GRAPH["pgae_lite.closedloop"]            # a subpackage runs its __init__
-    assert "pgae_lite.patterns" in GRAPH["pgae_lite.playground"]       # from . import patterns
+    assert GRAPH["pgae_lite.train.loop"] >= {"pgae_lite.config", "pgae_lite.model.pgae", "pgae_lite.util.storage"}
+    assert "pgae_lite.train.loop" in GRAPH["pgae_lite.runs.pipeline"]           # a function-level import counts
+    assert "pgae_lite.world.words" in GRAPH["pgae_lite.sim.actions"]      # from ..language
+    assert "pgae_lite.sim" in GRAPH["pgae_lite.robot.closedloop"]            # a subpackage runs its __init__
+    assert "pgae_lite.world.patterns" in GRAPH["pgae_lite.robot.playground"]       # from . import patterns
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
 
 
@@ -104,35 +104,35 @@ def test_no_import_cycles():
 
 def test_config_imports_nothing_that_imports_it():
     below = reachable("pgae_lite.config")
-    assert not below & {"pgae_lite.config", "pgae_lite.train", "pgae_lite.pipeline", "pgae_lite.reproduce",
-                        "pgae_lite.pgae"}, sorted(below)
+    assert not below & {"pgae_lite.config", "pgae_lite.train.loop", "pgae_lite.runs.pipeline", "pgae_lite.runs.reproduce",
+                        "pgae_lite.model.pgae"}, sorted(below)
     # plumbing: imports nothing of ours but the errors (which import nothing)
-    assert reachable("pgae_lite.utils") == {"pgae_lite.errors"}
-    assert not reachable("pgae_lite.errors")
-    assert "pgae_lite.train" not in reachable("pgae_lite.cae")
-    assert "pgae_lite.reproduce" not in reachable("pgae_lite.pipeline")
+    assert reachable("pgae_lite.util.storage") == {"pgae_lite.util.errors"}
+    assert not reachable("pgae_lite.util.errors")
+    assert "pgae_lite.train.loop" not in reachable("pgae_lite.cae")
+    assert "pgae_lite.runs.reproduce" not in reachable("pgae_lite.runs.pipeline")
 
 
 #: What the rest of the package builds on: none of these may import a module above it.
-HIGH = {"pgae_lite.train", "pgae_lite.evaluate", "pgae_lite.pipeline", "pgae_lite.reproduce", "pgae_lite.closedloop",
-        "pgae_lite.instructions", "pgae_lite.playground", "pgae_lite.viz", "pgae_lite.exercises"}
+HIGH = {"pgae_lite.train.loop", "pgae_lite.evaluate", "pgae_lite.runs.pipeline", "pgae_lite.runs.reproduce", "pgae_lite.robot.closedloop",
+        "pgae_lite.robot.instructions", "pgae_lite.robot.playground", "pgae_lite.viz", "pgae_lite.exercises"}
 
 
 def test_no_backwards_imports():
     """Low-level modules never import high-level ones (a split module must not reach back up)."""
     # the numbering needs only the words (and the words their error's base class)
-    assert reachable("pgae_lite.patterns") == {"pgae_lite.language", "pgae_lite.errors"}
-    assert reachable("pgae_lite.data") <= {"pgae_lite.language", "pgae_lite.patterns",
-                                           "pgae_lite.utils", "pgae_lite.errors"}
+    assert reachable("pgae_lite.world.patterns") == {"pgae_lite.world.words", "pgae_lite.util.errors", "pgae_lite.util"}
+    assert reachable("pgae_lite.data.dataset") <= {"pgae_lite.world.words", "pgae_lite.world.patterns", "pgae_lite.world",
+                                                   "pgae_lite.util.storage", "pgae_lite.util.errors", "pgae_lite.util"}
     for name in ("pgae_lite.sim.record", "pgae_lite.sim"):
-        assert "pgae_lite.data" not in reachable(name), name                  # the simulator needs the patterns only
+        assert "pgae_lite.data.dataset" not in reachable(name), name                  # the simulator needs the patterns only
     low = [n for n in MODULES if n.startswith("pgae_lite.sim") or n in (
-        "pgae_lite.language", "pgae_lite.patterns", "pgae_lite.data", "pgae_lite.original", "pgae_lite.layers",
-        "pgae_lite.signals", "pgae_lite.cae", "pgae_lite.simdata", "pgae_lite.config", "pgae_lite.pgae")]
+        "pgae_lite.world.words", "pgae_lite.world.patterns", "pgae_lite.data.dataset", "pgae_lite.data.original", "pgae_lite.model.layers",
+        "pgae_lite.model.signals", "pgae_lite.cae", "pgae_lite.data.simulated", "pgae_lite.config", "pgae_lite.model.pgae")]
     for name in low:
         assert not {h for h in reachable(name) for top in HIGH if h == top or h.startswith(top + ".")}, name
-    assert "pgae_lite.instructions" not in reachable("pgae_lite.closedloop")
-    assert not reachable("pgae_lite.viz") & {"pgae_lite.train", "pgae_lite.evaluate", "pgae_lite.closedloop"}
+    assert "pgae_lite.robot.instructions" not in reachable("pgae_lite.robot.closedloop")
+    assert not reachable("pgae_lite.viz") & {"pgae_lite.train.loop", "pgae_lite.evaluate", "pgae_lite.robot.closedloop"}
 
 
 def test_every_module_is_at_most_350_lines():

@@ -1,4 +1,4 @@
-"""pgae_lite.language: vocabulary, synonyms, parsing, encoding, word weights."""
+"""pgae_lite.world.words: vocabulary, synonyms, parsing, encoding, word weights."""
 from __future__ import annotations
 
 import re
@@ -7,8 +7,8 @@ from collections import Counter
 import pytest
 import torch
 
-from pgae_lite import language as L
-from pgae_lite.language import (BOS_EOS, INPUT_DIM, SIGNALS, VOCABULARY, LanguageError, decode, encode,
+from pgae_lite.world import words as L
+from pgae_lite.world.words import (BOS_EOS, INPUT_DIM, SIGNALS, VOCABULARY, LanguageError, decode, encode,
                                 equivalent_descriptions, is_correct, normalise_signal, one_hot,
                                 parse_description, signal_index, tokenize, word_weights)
 

@@ -1,4 +1,4 @@
-"""pgae_lite.layers: the peephole LSTM (TensorFlow's form), the fused LSTM, the GMU."""
+"""pgae_lite.model.layers: the peephole LSTM (TensorFlow's form), the fused LSTM, the GMU."""
 from __future__ import annotations
 
 import math
@@ -6,7 +6,7 @@ import math
 import pytest
 import torch
 
-from pgae_lite.layers import (FusedLSTM, GatedMultimodalUnit, PeepholeLSTM, PeepholeLSTMCell, make_recurrent,
+from pgae_lite.model.layers import (FusedLSTM, GatedMultimodalUnit, PeepholeLSTM, PeepholeLSTMCell, make_recurrent,
                               state_to_vector, vector_to_state)
 
 CLASSES = [PeepholeLSTM, FusedLSTM]

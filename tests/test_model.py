@@ -1,12 +1,12 @@
-"""pgae_lite.pgae: shapes, the authors' parameter count, the decoders' two modes."""
+"""pgae_lite.model.pgae: shapes, the authors' parameter count, the decoders' two modes."""
 from __future__ import annotations
 
 import pytest
 import torch
 
 from pgae_lite.config import ModelConfig
-from pgae_lite.pgae import PGAE, count_parameters
-from pgae_lite.signals import make_batch, signal_ids
+from pgae_lite.model.pgae import PGAE, count_parameters
+from pgae_lite.model.signals import make_batch, signal_ids
 
 INDEX = torch.tensor([72, 0, 100, 1])          # fast, slow, fast, slow (toy training samples)
 
@@ -34,12 +34,12 @@ def test_parameter_count_is_the_authors():
 
 
 def test_model_config_defaults_are_the_book_recipe():
-    import pgae_lite.pgae
+    import pgae_lite.model.pgae
     from pgae_lite.config import PROFILES
 
     assert ModelConfig() == PROFILES["book"].model and ModelConfig().joint_feedback == "start"
     assert PROFILES["paper"].model.joint_feedback == "predicted"      # the paper's decoder
-    assert pgae_lite.pgae.ModelConfig is ModelConfig                   # one class, importable from both
+    assert pgae_lite.model.pgae.ModelConfig is ModelConfig                   # one class, importable from both
 
 
 def test_fused_parameter_count():

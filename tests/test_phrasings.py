@@ -8,11 +8,11 @@ from dataclasses import replace
 
 import pytest
 
-from pgae_lite.errors import ArgumentError, ArgumentTypeError
-from pgae_lite.language import SYNONYMS, VOCABULARY
-from pgae_lite.paraphrases import load_paraphrases
-from pgae_lite.phrase_lexicon import LEXICON, MEANINGS, SLOTS, held_out_words, words_of
-from pgae_lite.phrasings import gerund, phrasing, phrasings, slot_meanings
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
+from pgae_lite.world.words import SYNONYMS, VOCABULARY
+from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.bert.phrase_lexicon import LEXICON, MEANINGS, SLOTS, held_out_words, words_of
+from pgae_lite.bert.phrasings import gerund, phrasing, phrasings, slot_meanings
 
 ALL_MEANINGS = list(itertools.product(*(MEANINGS[slot] for slot in SLOTS)))
 

@@ -1,9 +1,9 @@
-"""pgae_lite.pipeline.trained_pgae: the profile's recipe, caching by profile; unknown profiles."""
+"""pgae_lite.runs.pipeline.trained_pgae: the profile's recipe, caching by profile; unknown profiles."""
 from __future__ import annotations
 
 import pytest
 
-import pgae_lite.pipeline as pipeline
+import pgae_lite.runs.pipeline as pipeline
 from pgae_lite.config import get_profile
 
 UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
@@ -45,7 +45,7 @@ def test_several_models_train_side_by_side_and_then_load():
     import torch
 
     from pgae_lite.config import training_profile
-    from pgae_lite.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
+    from pgae_lite.runs.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
 
     for training in ("PGAE", "PGAE-no-plan"):     # left by an earlier run of this test in the same cache
         shutil.rmtree(_model_folder(training_profile(get_profile("smoke", seed=7), training), training),
@@ -67,14 +67,14 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
     import subprocess
     import sys
 
-    from pgae_lite import pipeline
+    from pgae_lite.runs import pipeline
     from pgae_lite.config import training_profile
 
     folder = pipeline._model_folder(training_profile(get_profile("smoke", seed=7), "PGAE"), "PGAE")
     shutil.rmtree(folder, ignore_errors=True)        # not trained yet (a trained one loads without waiting)
     pipeline.simulated_dataset("smoke", "cpu", progress=False)     # recorded before the other run starts
     monkeypatch.setattr(pipeline, "BUSY_POLL_SECONDS", 0.1)
-    holds = ("import sys, time; from pgae_lite.utils import folder_lock\n"
+    holds = ("import sys, time; from pgae_lite.util.storage import folder_lock\n"
              "with folder_lock(sys.argv[1]):\n    print('held', flush=True); time.sleep(3)")
     other = subprocess.Popen([sys.executable, "-c", holds, str(folder)], stdout=subprocess.PIPE, text=True)
     assert other.stdout.readline().strip() == "held"        # the other process is "training" now
@@ -86,9 +86,9 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
 def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(monkeypatch):
     from dataclasses import replace
 
-    import pgae_lite.phrase_lexicon as phrase_lexicon
+    import pgae_lite.bert.phrase_lexicon as phrase_lexicon
     from pgae_lite.config import training_profile
-    from pgae_lite.utils import config_digest
+    from pgae_lite.util.storage import config_digest
 
     prof = training_profile(get_profile("smoke"), "PGAE-BERT-phrasings")
     before = pipeline._model_folder(prof, "PGAE-BERT-phrasings")

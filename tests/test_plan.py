@@ -1,4 +1,4 @@
-"""pgae_lite.plan: the plan head's targets, loss and training, and models without it."""
+"""pgae_lite.model.plan: the plan head's targets, loss and training, and models without it."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -7,10 +7,10 @@ import pytest
 import torch
 
 from pgae_lite.config import PROFILES, ModelConfig, Profile, TrainConfig
-from pgae_lite.pgae import PGAE
-from pgae_lite.plan import PLAN_SIGNALS, keyframe_steps, plan_loss, plan_targets
-from pgae_lite.signals import DESCRIBE, EXECUTE, REPEAT_LANGUAGE
-from pgae_lite.train import train
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.model.plan import PLAN_SIGNALS, keyframe_steps, plan_loss, plan_targets
+from pgae_lite.model.signals import DESCRIBE, EXECUTE, REPEAT_LANGUAGE
+from pgae_lite.train.loop import train
 
 
 def test_keyframes_span_each_sample():
@@ -64,7 +64,7 @@ def test_head_learns_the_plan(toy_short):
     target = plan_targets(data["joints"], data["lengths"],
                           torch.as_tensor(toy_short.split("train").pattern[:24]), 4)
     fresh = PGAE(prof.model)
-    from pgae_lite.signals import make_batch, signal_ids
+    from pgae_lite.model.signals import make_batch, signal_ids
     index = torch.arange(24)
     batch = make_batch(data, index, signal_ids("execute", 24), index % 8)
     with torch.no_grad():
@@ -74,7 +74,7 @@ def test_head_learns_the_plan(toy_short):
 
 
 def test_probe_reads_what_is_linearly_there_and_not_what_is_not():
-    from pgae_lite.plan import probe_accuracy
+    from pgae_lite.model.plan import probe_accuracy
 
     g = torch.Generator().manual_seed(0)
     x, x_test = torch.randn(1000, 50, generator=g), torch.randn(200, 50, generator=g)
@@ -85,8 +85,8 @@ def test_probe_reads_what_is_linearly_there_and_not_what_is_not():
 
 
 def test_which_cube_probe_runs_on_a_model(toy_short):
-    from pgae_lite.data import Normaliser
-    from pgae_lite.plan import which_cube_probe
+    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.model.plan import which_cube_probe
 
     normaliser = Normaliser.fit(toy_short.split("train"))
     accuracy = which_cube_probe(PGAE(ModelConfig(units=16)), toy_short, normaliser)

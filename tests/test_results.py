@@ -1,8 +1,8 @@
 """Results are data: every committed result file is complete, and every quote of one agrees with it.
 
-The drift test: the README's headline table must be what ``python -m pgae_lite.results
+The drift test: the README's headline table must be what ``python -m pgae_lite.runs.results
 --readme`` writes from results/table1-original.json today; every figure a chapter or
-the introduction quotes goes through ``pgae_lite.results`` (``results.quote(...)`` in
+the introduction quotes goes through ``pgae_lite.runs.results`` (``results.quote(...)`` in
 a code cell, shown with glue), and every such quote must resolve in its file.
 """
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from pgae_lite import results
+from pgae_lite.runs import results
 
 ROOT = Path(__file__).resolve().parent.parent
 QUOTE = re.compile(r"results\.(?:quote|value)\(\s*([\"'][^)]*)\)")
@@ -34,7 +34,7 @@ def test_the_readme_headline_table_is_the_one_the_result_file_gives():
     readme = (ROOT / "README.md").read_text()
     assert results.readme_with_headline(readme) == readme, (
         "README.md's headline table differs from results/table1-original.json: "
-        "run `python -m pgae_lite.results --readme`")
+        "run `python -m pgae_lite.runs.results --readme`")
 
 
 def code_of(path: Path) -> str:

@@ -1,13 +1,13 @@
-"""pgae_lite.simdata and pgae_lite.pipeline: the cache of simulated episodes, features, the dataset."""
+"""pgae_lite.data.simulated and pgae_lite.runs.pipeline: the cache of simulated episodes, features, the dataset."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
 from pgae_lite.config import SMOKE_PATTERNS
-from pgae_lite.data import PGAEDataset
-from pgae_lite.patterns import Pattern
-from pgae_lite.simdata import (CorruptEpisodeError, DatasetConfig, episode_folder, generate, load_episode,
+from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.data.simulated import (CorruptEpisodeError, DatasetConfig, episode_folder, generate, load_episode,
                                load_episode_file)
 
 
@@ -67,7 +67,7 @@ def test_config_key_changes_with_the_config():
 
 
 def test_simulated_dataset_has_the_authors_layout(smoke_episodes):
-    from pgae_lite.pipeline import simulated_dataset
+    from pgae_lite.runs.pipeline import simulated_dataset
 
     ds = simulated_dataset("smoke", progress=False)
     n = len(SMOKE_PATTERNS)

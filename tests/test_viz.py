@@ -9,11 +9,11 @@ import pytest
 import torch
 from matplotlib.figure import Figure
 
-from pgae_lite.data import Normaliser
+from pgae_lite.data.dataset import Normaliser
 from pgae_lite.evaluate import Predictions
-from pgae_lite.language import SIGNALS
-from pgae_lite.signals import make_batch
-from pgae_lite.toydata import toy_dataset
+from pgae_lite.world.words import SIGNALS
+from pgae_lite.model.signals import make_batch
+from pgae_lite.data.toy import toy_dataset
 from pgae_lite.viz import (plot_gates, plot_history, plot_joints, plot_vision, prediction_frame,
                            signal_table, wrong_words)
 
@@ -102,7 +102,7 @@ def test_animate_frames_plays_every_nth_step_and_embeds_offline():
 
 
 def test_plot_patterns_labels_all_144_and_outlines_test_patterns():
-    from pgae_lite.patterns import TEST_PATTERNS
+    from pgae_lite.world.patterns import TEST_PATTERNS
     from pgae_lite.viz import plot_patterns
 
     fig = plot_patterns(marked=(0, 1, 2))

@@ -1,4 +1,4 @@
-"""pgae_lite.world and the package with a new colour: the default world is the paper's,
+"""pgae_lite.world.colours and the package with a new colour: the default world is the paper's,
 an extended one records, trains and is checked (the guided project)."""
 from __future__ import annotations
 
@@ -8,17 +8,17 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite import language as L
+from pgae_lite.world import words as L
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.data import Normaliser, from_recordings
+from pgae_lite.data.dataset import Normaliser, from_recordings
 from pgae_lite.evaluate import Predictions
 from pgae_lite.exercises import check_new_colour
-from pgae_lite.language import DEFAULT_LEXICON, LanguageError
-from pgae_lite.patterns import TEST_PATTERNS, Pattern
-from pgae_lite.pgae import PGAE
-from pgae_lite.simdata import GENERATOR_VERSION, DatasetConfig
-from pgae_lite.utils import config_digest
-from pgae_lite.world import DEFAULT_WORLD, World, with_colour
+from pgae_lite.world.words import DEFAULT_LEXICON, LanguageError
+from pgae_lite.world.patterns import TEST_PATTERNS, Pattern
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.data.simulated import GENERATOR_VERSION, DatasetConfig
+from pgae_lite.util.storage import config_digest
+from pgae_lite.world.colours import DEFAULT_WORLD, World, with_colour
 
 ORANGE = (0.98, 0.50, 0.05, 1.0)
 WORLD = with_colour("orange", "amber", ORANGE)
@@ -149,8 +149,8 @@ def test_simulator_builds_and_records_the_new_cube():
 
 # ------------------------------------------------------------------ model and training
 def test_pgae_for_the_larger_vocabulary_trains_and_loads(tmp_path):
-    from pgae_lite.extended import load_pgae
-    from pgae_lite.train import train
+    from pgae_lite.runs.new_colour import load_pgae
+    from pgae_lite.train.loop import train
 
     data = tiny(WORLD, [0, 77, 144, 150, 165, 184])
     assert data.descriptions.max() == 24

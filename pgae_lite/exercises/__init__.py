@@ -14,9 +14,9 @@ Sec. 4: the vocabulary, and our simulator's cube colours.
 
 Every check is importable from here, e.g. ``from pgae_lite.exercises import check_gmu``.
 """
-from .model import check_bottleneck, check_gmu, check_lstm_step, check_peephole_step, check_signal_probs
-from .result import CheckResult
-from .world import check_colour, check_new_colour, check_vocabulary
+from pgae_lite.exercises.model import check_bottleneck, check_gmu, check_lstm_step, check_peephole_step, check_signal_probs
+from pgae_lite.exercises.result import CheckResult
+from pgae_lite.exercises.world import check_colour, check_new_colour, check_vocabulary
 
 __all__ = ["CheckResult", "check_vocabulary", "check_colour", "check_new_colour",
            "check_peephole_step", "check_lstm_step", "check_gmu",

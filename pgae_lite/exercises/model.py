@@ -19,15 +19,15 @@ from typing import Callable, Sequence
 import torch
 from torch import nn
 
-from ..config import ModelConfig
-from ..data import Normaliser
-from ..language import SIGNALS, word_weights
-from ..layers import GatedMultimodalUnit, PeepholeLSTMCell
-from ..pgae import PGAE, count_parameters
-from ..signals import SIGNAL_PROBS, make_batch, sample_signals
-from ..toydata import toy_dataset
-from ..train import pgae_loss
-from .result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
+from pgae_lite.config import ModelConfig
+from pgae_lite.data.dataset import Normaliser
+from pgae_lite.world.words import SIGNALS, word_weights
+from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell
+from pgae_lite.model.pgae import PGAE, count_parameters
+from pgae_lite.model.signals import SIGNAL_PROBS, make_batch, sample_signals
+from pgae_lite.data.toy import toy_dataset
+from pgae_lite.train.loop import pgae_loss
+from pgae_lite.exercises.result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
                      _pair, _shape, _unchanged, _value_problem)
 
 LSTM_EQUATION = ("[i; j; f; o] = x W_x + h W_h + b, c_t = σ(f + 0.8 + p_f ⊙ c_{t-1}) ⊙ c_{t-1} "
@@ -38,7 +38,7 @@ GMU_EQUATION = ("A_h = tanh(W_A f_act + b), L_h = tanh(W_L f_lang + b), z = σ(W
 
 # ------------------------------------------------------------------ the LSTM step: (a) and (d)
 def _step(x, h, c, cell, order="ijfo", forget_bias=0.8, peepholes=True, tanh_j=True, tanh_c=True, o_new_c=True):
-    """:class:`~pgae_lite.layers.PeepholeLSTMCell`'s step, with switches that reproduce common mistakes."""
+    """:class:`~pgae_lite.model.layers.PeepholeLSTMCell`'s step, with switches that reproduce common mistakes."""
     g = dict(zip(order, (x @ cell.weight_x + h @ cell.weight_h + cell.bias).chunk(4, dim=1)))
     p_i, p_f, p_o = (cell.peep_i, cell.peep_f, cell.peep_o) if peepholes else (0.0, 0.0, 0.0)
     c_new = (torch.sigmoid(g["f"] + forget_bias + p_f * c) * c
@@ -94,7 +94,7 @@ def _check_step(student: Callable, peepholes: bool, name: str, seed: int) -> Che
 def check_peephole_step(student_step: Callable, seed: int = 0) -> CheckResult:
     """(a) ``student_step(x, (h, c), cell) -> (h, c)``: one peephole LSTM step against the package's.
 
-    ``cell`` is a :class:`~pgae_lite.layers.PeepholeLSTMCell`: use ``cell.weight_x``, ``weight_h``, ``bias``,
+    ``cell`` is a :class:`~pgae_lite.model.layers.PeepholeLSTMCell`: use ``cell.weight_x``, ``weight_h``, ``bias``,
     ``peep_i``, ``peep_f``, ``peep_o`` and the forget bias 0.8 (TensorFlow's form, as in the authors' code).
     """
     return _check_step(student_step, True, "peephole LSTM step", seed)
@@ -108,7 +108,7 @@ def check_lstm_step(student_step: Callable, seed: int = 0) -> CheckResult:
 # ------------------------------------------------------------------ (b) the GMU
 @torch.random.fork_rng(devices=[])
 def check_gmu(student: type | nn.Module | Callable, seed: int = 0) -> CheckResult:
-    """(b) A GMU forward against :class:`~pgae_lite.layers.GatedMultimodalUnit` (paper Sec. 3, "Bottleneck").
+    """(b) A GMU forward against :class:`~pgae_lite.model.layers.GatedMultimodalUnit` (paper Sec. 3, "Bottleneck").
 
     ``student`` is a module class, built as ``cls(action_dim, language_dim, hidden_dim)`` with layers
     named as in the package (``action_linear``, ``language_linear``, ``gate_linear``: the check copies
@@ -236,7 +236,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
 # ------------------------------------------------------------------ (e) signal probabilities
 def check_signal_probs(probs: Sequence[float] | dict[str, float], drop: str | None = "repeat both") -> CheckResult:
     """(e) Training probabilities of the signals with ``drop`` left out: a list in the order of
-    :data:`~pgae_lite.language.SIGNALS`, or a dict by signal name (missing names count as 0).
+    :data:`~pgae_lite.world.words.SIGNALS`, or a dict by signal name (missing names count as 0).
     Train with them as ``get_profile(..., signal_probs=probs)`` (:class:`~pgae_lite.config.TrainConfig`)."""
     result = CheckResult(f"signal probabilities without {drop!r}" if drop else "signal probabilities")
     if drop is not None and drop not in SIGNALS:

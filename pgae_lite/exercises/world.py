@@ -2,7 +2,7 @@
 
 Paper, Sec. 4 (the vocabulary of the descriptions) and our simulator's cube
 colours (chapters 01, 02 and 03); :func:`check_new_colour` checks the guided
-project "Teach NICO a new colour" (not from the paper: :mod:`pgae_lite.world`)
+project "Teach NICO a new colour" (not from the paper: :mod:`pgae_lite.world.colours`)
 with the paper's Table 1 metrics. Each check returns a
 :class:`~pgae_lite.exercises.result.CheckResult`.
 """
@@ -13,11 +13,11 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..data import Normaliser, PGAEDataset
-from ..evaluate import nrmse, predict
-from ..language import COLOURS, SIGNALS, VOCABULARY
-from ..world import World
-from .result import RAISED, CheckResult, _call, _numbers
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.evaluate import nrmse, predict
+from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
+from pgae_lite.world.colours import World
+from pgae_lite.exercises.result import RAISED, CheckResult, _call, _numbers
 
 #: Describe accuracy (%) on the held-out episodes that move the new colour's cube.
 MIN_DESCRIBE_ACCURACY = 75.0
@@ -63,8 +63,8 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
     """(f) A new cube colour: one lowercase word and an opaque RGBA in [0, 1] that the camera can tell
     apart from the other cubes and the table (some channel differs by ``min_difference`` or more).
 
-    ``world``: compare with its colours too (:func:`pgae_lite.world.with_colour`)."""
-    from ..sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
+    ``world``: compare with its colours too (:func:`pgae_lite.world.colours.with_colour`)."""
+    from pgae_lite.sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
 
     colours = world.lexicon.colours if world is not None else COLOURS
     rgbas = {**CUBE_RGBA, **(world.rgba if world is not None else {})}
@@ -106,7 +106,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
     """Does a retrained model describe and execute the new colour's held-out episodes?
 
     The held-out episodes are the test patterns of the new arrangements (a cube of
-    ``colour`` on the table; :func:`pgae_lite.world.with_colour` chose them). Passing
+    ``colour`` on the table; :func:`pgae_lite.world.colours.with_colour` chose them). Passing
     needs both, measured as in Table 1 (:mod:`pgae_lite.evaluate`):
 
     - describe: at least ``min_accuracy`` % (75) right descriptions of the episodes that
@@ -133,7 +133,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
     if not held.any():
         return result.fail(f"the dataset has no held-out episodes with a {colour} cube",
                            "record the new patterns and build the data with "
-                           "pgae_lite.extended.extended_dataset(world)")
+                           "pgae_lite.runs.new_colour.extended_dataset(world)")
     if int(dataset.descriptions.max()) >= lexicon.size:
         return result.fail(f"the dataset has word indices up to "
                            f"{int(dataset.descriptions.max())}, beyond the model's "

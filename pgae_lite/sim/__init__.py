@@ -15,16 +15,16 @@ Quick start::
     ep = record_episode(pattern=0, variation=0)     # push red (left cube) slowly
     ep.joints.shape, ep.images.shape                # (100, 5), (100, 120, 160, 3)
 """
-from ._quiet import silenced
+from pgae_lite.sim._quiet import silenced
 
 with silenced(2):  # pybullet announces its build time on stderr when first imported
     import pybullet  # noqa: F401
 
-from .actions import ActionCheck, check_action
-from .record import (AGENTS, Episode, Execution, SimConfig, Simulation, episode_seed, execute_trajectory,
+from pgae_lite.sim.actions import ActionCheck, check_action
+from pgae_lite.sim.record import (AGENTS, Episode, Execution, SimConfig, Simulation, episode_seed, execute_trajectory,
                      record_episode, scene_layout)
-from .robot import HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot
-from .scene import CUBE_RGBA, Scene, SceneLayout
+from pgae_lite.sim.robot import HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot
+from pgae_lite.sim.scene import CUBE_RGBA, Scene, SceneLayout
 
 __all__ = ["AGENTS", "ActionCheck", "CUBE_RGBA", "Episode", "Execution", "HOME_POSE", "JOINT_LIMITS",
            "JOINT_NAMES", "Robot", "Scene", "SceneLayout", "SimConfig", "Simulation", "check_action",

@@ -33,12 +33,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..patterns import NUMBERING, Pattern
-from ..world import DEFAULT_WORLD, EXTENSION_NUMBERING, World
-from .actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
+from pgae_lite.world.patterns import NUMBERING, Pattern
+from pgae_lite.world.colours import DEFAULT_WORLD, EXTENSION_NUMBERING, World
+from pgae_lite.sim.actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
                       check_action, plan_action, sample_variation, world_direction)
-from .robot import JOINT_LIMITS, JOINT_NAMES, Robot
-from .scene import CUBE_Y, IMAGE_HEIGHT, IMAGE_WIDTH, TABLE_CENTRE_X, Scene, SceneLayout
+from pgae_lite.sim.robot import JOINT_LIMITS, JOINT_NAMES, Robot
+from pgae_lite.sim.scene import CUBE_Y, IMAGE_HEIGHT, IMAGE_WIDTH, TABLE_CENTRE_X, Scene, SceneLayout
 
 AGENTS = ("nico", "opposite")
 log = logging.getLogger(__name__)
@@ -76,7 +76,7 @@ class SimConfig:
 class Episode:
     """One recording of one pattern (see the module docstring for who does what)."""
 
-    pattern: int                  # 0-143, pgae_lite.patterns numbering
+    pattern: int                  # 0-143, pgae_lite.world.patterns numbering
     variation: int                # 0-5
     seed: int                     # the seed that produced this (valid) episode
     attempts: int                 # 1 if the first seed worked
@@ -94,7 +94,7 @@ class Execution:
 
     The outcome of driving one agent along a joint trajectory: :meth:`Simulation.run`
     (the recordings, :func:`execute_trajectory`) and the model's executions
-    (:func:`pgae_lite.closedloop.open_loop`, :func:`~pgae_lite.closedloop.closed_loop`).
+    (:func:`pgae_lite.robot.closedloop.open_loop`, :func:`~pgae_lite.robot.closedloop.closed_loop`).
     """
 
     pattern: int                  # the scene (and the action the check expects), 0-143
@@ -121,7 +121,7 @@ class Execution:
 def episode_seed(pattern: int, variation: int, base_seed: int = 0, attempt: int = 0) -> int:
     """The integer seed of one attempt: ((base_seed * 144 + pattern) * 100 + variation) * 100 + attempt.
 
-    Patterns beyond 143 (:mod:`pgae_lite.world`) reuse base_seed + 1's seeds (no clash).
+    Patterns beyond 143 (:mod:`pgae_lite.world.colours`) reuse base_seed + 1's seeds (no clash).
     """
     return ((base_seed * 144 + pattern) * 100 + variation) * 100 + attempt
 
@@ -164,7 +164,7 @@ class Simulation:
 
     Each :meth:`reset` rebuilds the world (bit-reproducible); ``agent="opposite"``
     makes the opposite agent act while NICO sits still. ``world`` (default: the
-    paper's) gives the patterns' colours (:mod:`pgae_lite.world`).
+    paper's) gives the patterns' colours (:mod:`pgae_lite.world.colours`).
     """
 
     def __init__(self, config: SimConfig = SimConfig(),
@@ -279,7 +279,7 @@ def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig()
                    base_seed: int = 0, world: World = DEFAULT_WORLD) -> Episode:
     """Record one episode: NICO acting and the opposite agent acting, both checked (see module docstring).
 
-    ``world``: patterns beyond 143, their colours (:func:`pgae_lite.world.with_colour`).
+    ``world``: patterns beyond 143, their colours (:func:`pgae_lite.world.colours.with_colour`).
     """
     pat = _validate(pattern, variation, base_seed, world)
     sim = _simulation(config, world)

@@ -38,7 +38,7 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
-from ..utils import atomic_write_text, config_digest
+from pgae_lite.util.storage import atomic_write_text, config_digest
 
 #: The 5 recorded joints of the left arm, from shoulder to wrist.
 JOINT_NAMES: tuple[str, ...] = ("l_shoulder_z", "l_shoulder_y", "l_arm_x", "l_elbow_y", "l_wrist_y")

@@ -35,11 +35,11 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
-from ..language import COLOURS
-from ._quiet import silenced
-from .robot import Robot
+from pgae_lite.world.words import COLOURS
+from pgae_lite.sim._quiet import silenced
+from pgae_lite.sim.robot import Robot
 
-#: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.language`.
+#: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.world.words`.
 CUBE_RGBA: dict[str, tuple[float, float, float, float]] = {
     "red": (0.86, 0.08, 0.06, 1.0),
     "green": (0.10, 0.72, 0.12, 1.0),
@@ -80,7 +80,7 @@ class SceneLayout:
     """Where the cubes are: colours and centres (world frame, metres).
 
     ``palette``: RGBA of colours beyond :data:`CUBE_RGBA` (a
-    :class:`pgae_lite.world.World`'s ``rgba``), e.g.
+    :class:`pgae_lite.world.colours.World`'s ``rgba``), e.g.
     ``SceneLayout("orange", "blue", palette=world.rgba)``.
     """
 

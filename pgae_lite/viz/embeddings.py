@@ -13,7 +13,7 @@ import numpy as np
 import torch
 from matplotlib.figure import Figure
 
-from ._common import _numpy
+from pgae_lite.viz._common import _numpy
 
 #: A display colour for each colour word of the dataset (canonical words).
 WORD_COLOURS: dict[str, str] = {"red": "tab:red", "green": "tab:green", "blue": "tab:blue", "yellow": "gold",

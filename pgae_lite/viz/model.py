@@ -16,10 +16,10 @@ import torch
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ..data import PGAEDataset, description_text
-from ..language import CANONICAL, SIGNALS, SLOT_NAMES, SLOTS, VOCABULARY
-from ..signals import SignalBatch
-from ._common import JOINT_NAMES, _numpy
+from pgae_lite.data.dataset import PGAEDataset, description_text
+from pgae_lite.world.words import CANONICAL, SIGNALS, SLOT_NAMES, SLOTS, VOCABULARY
+from pgae_lite.model.signals import SignalBatch
+from pgae_lite.viz._common import JOINT_NAMES, _numpy
 
 #: One colour per signal, the same in every figure of the book.
 SIGNAL_COLOURS: dict[str, str] = {
@@ -116,7 +116,7 @@ def _words(tokens: Sequence[int]) -> str:
 def signal_table(batch: SignalBatch) -> pd.DataFrame:
     """One row per sample of ``batch``: what goes into the encoders and what the decoders must produce.
 
-    Build ``batch`` with :func:`pgae_lite.signals.make_batch`, e.g. one sample
+    Build ``batch`` with :func:`pgae_lite.model.signals.make_batch`, e.g. one sample
     under each of the five signals, to get the paper's "Signals" list as a table.
     """
     rows = []

@@ -13,8 +13,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..patterns import ACTION_SIDES, ARRANGEMENTS, TEST_PATTERNS, pattern_parts
-from ._common import JOINT_NAMES, _numpy
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, TEST_PATTERNS, pattern_parts
+from pgae_lite.viz._common import JOINT_NAMES, _numpy
 
 def plot_frames(rows: Mapping[str, np.ndarray], count: int = 6, size: float = 1.7) -> Figure:
     """Film strips: ``count`` evenly spaced frames of each sequence, one row per entry of ``rows``.
@@ -99,7 +99,7 @@ def plot_patterns(values: Mapping[int, float] | None = None, marked: Sequence[in
     The cell of pattern ``72·speed + 6·arrangement + action`` is in row
     ``arrangement`` and column ``6·speed + action``, labelled with its number.
     Without ``values`` a cell is dark for a test pattern
-    (:data:`pgae_lite.patterns.TEST_PATTERNS`) and light for a training one; with
+    (:data:`pgae_lite.world.patterns.TEST_PATTERNS`) and light for a training one; with
     ``values`` (pattern -> number, e.g. accuracy per pattern, ``label`` names
     it) the cells are coloured by value, missing ones blank, and test
     patterns are outlined. ``marked`` patterns (e.g. a profile's subset) get

@@ -16,7 +16,7 @@ import torch
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ._common import JOINT_NAMES, _numpy
+from pgae_lite.viz._common import JOINT_NAMES, _numpy
 
 #: One colour per image channel (R, G, B), the same in every figure of the book.
 CHANNEL_COLOURS: tuple[str, ...] = ("tab:red", "tab:green", "tab:blue")

@@ -1,0 +1,110 @@
+"""Training PGAE-BERT on instructions said in many ways (not in the paper).
+
+Paper, Sec. 3: PGAE-BERT's pretrained encoder "has the potential to recognise
+unseen natural language", but trained on the dataset's three-word descriptions
+alone it reads a free-form instruction as something far from anything it was
+trained on. With ``TrainConfig.phrasings`` = K > 0, every sample whose signal
+takes a description (execute, repeat both, repeat language; or those of
+``TrainConfig.phrasing_signals``) reads, with probability
+``TrainConfig.phrasing_prob``, one of K sentences that say its
+description in other words (:func:`pgae_lite.bert.phrasings.phrasings`, a grammar
+and lexicon written for the purpose, independent of the held-out test
+sentences) instead of the description itself. The targets stay the dataset's
+words. The transformer stays frozen (up to its top layer, when that is tuned:
+:mod:`pgae_lite.bert.tuned_layer`): the K sentences of each meaning and reading
+signal are encoded once (``S x 36 x K`` sentences for S signals) and kept on
+disk like its table of fixed inputs. A training step then adds only what comes
+after the cache for the picked sentences: a lookup of their sentence vectors
+for the mean; for the attention pooling (:mod:`pgae_lite.bert.attention_pooling`)
+the trained attention over their cached token vectors, and before it the tuned
+top layer, if there is one, over the cached input of that layer.
+"""
+from __future__ import annotations
+
+import itertools
+
+import torch
+
+from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
+from pgae_lite.bert.phrase_lexicon import PhraseLexicon
+from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder, cached_token_vectors
+from pgae_lite.config import TrainConfig
+from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, input_text
+from pgae_lite.model.signals import LANG_IN, SignalBatch
+from pgae_lite.bert.tuned_layer import TRAIN_EVERY
+from pgae_lite.util.storage import cache_dir, config_digest, load_torch, save_torch
+
+MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
+TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, repeat both, repeat language
+
+
+class PhrasingBank:
+    """Sentence vectors of K phrasings per (reading signal, meaning): a tensor (S, 36, K, D), S <= 3."""
+
+    def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
+                 lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
+                 prob: float = TrainConfig.phrasing_prob):
+        if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
+            raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
+                             "language_encoder='pretrained' or 'pretrained-attention'); this model has "
+                             f"{type(encoder).__name__}")
+        self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
+        # only the signals that read phrasings are encoded (the others' rows would never be read)
+        self.signals = tuple(s for s in TEXT_SIGNALS if signals is None or SIGNALS[s] in signals)
+        self.texts = [input_text(SIGNALS[s], text) for s in self.signals for m in MEANINGS
+                      for text in phrasings(*m, per_meaning, seed=seed, lexicon=lexicon)]
+        shape = (len(self.signals), len(MEANINGS), per_meaning)
+        device = next(encoder.buffers()).device
+        if isinstance(encoder, AttentivePretrainedEncoder):
+            # token vectors, pooled by the trained attention at every step; float16 halves their memory
+            states, mask = encoder.free_text_vectors(self.texts, "phrasings", torch.float16)
+            self.states = states.reshape(*shape, *states.shape[1:]).to(device)   # (S, 36, K, T, D)
+            self.mask = mask.reshape(*shape, -1).to(device)                       # (S, 36, K, T)
+        else:
+            key = config_digest({"texts": self.texts, "encoder": encoder.transformer.digest,
+                                 "pooling": encoder.pooling})
+            path = cache_dir() / "embeddings" / f"phrasings-{key}.pt"
+            if path.exists():
+                vectors = load_torch(path, ("vectors",), what="phrasing cache")["vectors"]
+            else:
+                vectors = encoder._run_transformer(self.texts)          # (S·36·K, D), once
+                save_torch({"vectors": vectors}, path)
+            self.vectors = vectors.reshape(*shape, -1).to(device)        # (S, 36, K, D)
+        # input token -> its canonical word's position in its slot (-1: not a description word)
+        self.slot_index = torch.full((len(VOCABULARY),), -1, dtype=torch.long)
+        for word, canonical in CANONICAL.items():
+            slot = next(slot for slot in SLOTS if canonical in slot)
+            self.slot_index[VOCABULARY.index(word)] = slot.index(canonical)
+        # signal -> its row in the bank (-1: the signal reads no phrasings)
+        self.signal_row = torch.full((len(SIGNALS),), -1, dtype=torch.long)
+        for row, s in enumerate(self.signals):
+            self.signal_row[s] = row
+
+    def meanings(self, tokens: torch.Tensor) -> torch.Tensor:
+        """``lang_tokens`` (B, 5) with a description -> meaning index 0..35 (B,)."""
+        a, c, s = self.slot_index[tokens[:, 1:4].cpu()].unbind(1)         # each (B,)
+        return (a * len(SLOTS[1]) + c) * len(SLOTS[2]) + s
+
+    def features(self, model: torch.nn.Module, batch: SignalBatch,
+                 generator: torch.Generator, step: int = 0) -> torch.Tensor:
+        """The language features of a training batch (B, D): phrasings for some samples.
+
+        ``step``: the training step (from 0), which says whether a tuned top layer learns in it."""
+        base = model.language_encoder(batch.lang_tokens, batch.lang_lengths)
+        size = len(batch.signal)
+        row = self.signal_row[batch.signal.cpu()]                            # (B,), -1: no description
+        takes = (row >= 0) & (torch.rand(size, generator=generator) < self.prob)
+        which = torch.randint(self.per_meaning, (size,), generator=generator)
+        if not takes.any():
+            return base
+        rows = takes.nonzero().flatten()
+        meaning = self.meanings(batch.lang_tokens[rows])
+        pick = (row[rows], meaning, which[rows])
+        if isinstance(self.encoder, AttentivePretrainedEncoder):
+            # a tuned top layer learns from the phrasings of one step in TRAIN_EVERY (forward only on the others)
+            said = self.encoder.pool_free_text(self.states[pick], self.mask[pick],    # trained: gradients flow
+                                               train_top=(step + 1) % TRAIN_EVERY == 0)
+        else:
+            said = self.vectors[pick]
+        return base.index_put((rows.to(base.device),), said)

@@ -1,0 +1,320 @@
+"""Datasets: one type for the authors' recordings and for our simulator's, and their normalisation.
+
+Paper, Sec. 4 (Dataset). A sample is one recording of one of 144 patterns
+(12 cube arrangements x 12 actions, :mod:`pgae_lite.world.patterns`): per time step
+5 joint angles and 30 visual features (10 per colour channel), for NICO's own
+view and for the opposite agent's; slow actions last 100 steps, fast ones 50,
+padded to 100 with a mask. Each sample carries the 8 equivalent descriptions
+of its action.
+
+:func:`pgae_lite.data.original.load_original` reads the authors' ``target/`` tree;
+:class:`Normaliser` maps every modality to [-1, 1] with statistics from the
+training split only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable
+
+import numpy as np
+import torch
+
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.world.words import VOCABULARY
+from pgae_lite.world.patterns import MAX_STEPS, Pattern
+from pgae_lite.util.storage import array_digest, atomic_write
+
+JOINT_DIM = 5
+VISION_DIM = 30
+
+
+class DataFormatError(PGAELiteError, ValueError):
+    """The authors' data folder (:mod:`pgae_lite.data.original`) or a dataset file is missing or malformed."""
+
+
+_ARRAYS = ("joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern",
+           "is_test", "ids", "action", "arrangement")
+
+
+@dataclass
+class PGAEDataset:
+    """All samples of a dataset, padded to ``MAX_STEPS`` (values past a length are 0).
+
+    Arrays (N = number of samples, T = 100 steps):
+    ``joints`` (N, T, 5) and ``vision`` / ``vision_opposite`` (N, T, 30) in the
+    data's own units; ``lengths`` (N,); ``descriptions`` (N, 8, 3) word indices
+    of the 8 equivalent descriptions; ``pattern`` (N,) pattern number 0-143;
+    ``is_test`` (N,); ``ids`` sample names; ``action`` (e.g. ``PUSH-L-SLOW``)
+    and ``arrangement`` (e.g. ``red+blue``) per sample.
+    """
+
+    joints: np.ndarray
+    vision: np.ndarray
+    vision_opposite: np.ndarray
+    lengths: np.ndarray
+    descriptions: np.ndarray
+    pattern: np.ndarray
+    is_test: np.ndarray
+    ids: np.ndarray
+    action: np.ndarray
+    arrangement: np.ndarray
+    source: str = ""
+    extras: dict = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.lengths)
+
+    @property
+    def mask(self) -> np.ndarray:
+        """(N, T) bool, True on valid steps."""
+        return np.arange(self.joints.shape[1])[None, :] < self.lengths[:, None]
+
+    def subset(self, index: np.ndarray) -> "PGAEDataset":
+        """The samples at ``index`` (a bool mask or integer indices)."""
+        arrays = {k: getattr(self, k)[index] for k in _ARRAYS}
+        return PGAEDataset(**arrays, source=self.source, extras=self.extras)
+
+    def split(self, name: str) -> "PGAEDataset":
+        """``"train"`` or ``"test"`` samples; :class:`DataFormatError` if none."""
+        if name not in ("train", "test"):
+            raise ValueError(f"unknown split {name!r}; the splits are: train, test")
+        part = self.subset(self.is_test if name == "test" else ~self.is_test)
+        if not len(part):
+            other = "training" if name == "test" else "test"
+            raise DataFormatError(
+                f"{self.source or 'the dataset'} has no {name} samples (all "
+                f"{len(self)} are {other} samples); training needs training samples "
+                "and evaluation test samples")
+        return part
+
+    def check_finite(self) -> None:
+        """:class:`DataFormatError` naming the sample if a valid step is not finite."""
+        for name in ("joints", "vision", "vision_opposite"):
+            bad = ~np.isfinite(getattr(self, name)).all(-1) & self.mask     # (N, T)
+            if bad.any():
+                sample, step = np.argwhere(bad)[0]
+                raise DataFormatError(
+                    f"{self.source or 'dataset'}: sample {self.ids[sample]}, step "
+                    f"{step}: {name} holds NaN or infinity; every value must be a "
+                    "finite number")
+
+    def joint_range(self) -> float:
+        """Observed range (max - min) of joint values over valid steps: nRMSE's denominator."""
+        valid = self.joints[self.mask]
+        return float(valid.max() - valid.min())
+
+    def save(self, path: str | Path, fingerprint: str = "") -> None:
+        """Write every array to one ``.npz`` file, atomically (temporary file, rename).
+
+        ``fingerprint`` (e.g. a digest of the configs that made the data) is stored
+        with a digest of the arrays; :meth:`load` can ask for both.
+        """
+        path = Path(path)
+        arrays = {k: getattr(self, k) for k in _ARRAYS}
+        digest = array_digest({**arrays, "fingerprint": np.array(fingerprint)})
+        with atomic_write(path) as f:
+            np.savez_compressed(f, source=np.array(self.source),
+                                digest=np.array(digest),
+                                fingerprint=np.array(fingerprint), **arrays)
+
+    @classmethod
+    def load(cls, path: str | Path, fingerprint: str | None = None) -> "PGAEDataset":
+        """A file written by :meth:`save`; :class:`DataFormatError` if it is damaged.
+
+        With ``fingerprint``, the file must have been saved with that fingerprint
+        and its arrays must match the digest saved with them (a cache's check).
+        """
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                arrays = {k: f[k] for k in _ARRAYS}
+                source = str(f["source"])
+                saved = {k: str(f[k]) if k in f else None
+                         for k in ("fingerprint", "digest")}
+        except Exception as e:  # zip, zlib, missing keys: all mean a damaged or foreign file
+            raise DataFormatError(f"{path}: not a readable PGAE dataset file ({type(e).__name__}: {e})") from None
+        if fingerprint is not None and saved["fingerprint"] != fingerprint:
+            found = (f"fingerprint {saved['fingerprint']!r}" if saved["fingerprint"]
+                     else "saved without a fingerprint")
+            raise DataFormatError(f"{path}: made from other data or configs ({found}, "
+                                  f"expected {fingerprint!r})")
+        stamp = np.array(saved["fingerprint"] or "")
+        content = array_digest({**arrays, "fingerprint": stamp})
+        checked = fingerprint is not None or saved["digest"] is not None
+        if checked and saved["digest"] != content:
+            raise DataFormatError(f"{path}: its arrays do not match the digest saved "
+                                  "with them")
+        n = len(arrays["lengths"])
+        widths = {"joints": JOINT_DIM, "vision": VISION_DIM,
+                  "vision_opposite": VISION_DIM}
+        if any(len(a) != n for a in arrays.values()) or any(
+                arrays[k].shape[1:] != (MAX_STEPS, w) for k, w in widths.items()):
+            raise DataFormatError(f"{path}: arrays of inconsistent shapes")
+        data = cls(**arrays, source=source)
+        data.check_finite()
+        return data
+
+
+#: How visual features can be scaled to [-1, 1] (see :meth:`Normaliser.fit`).
+VISION_SCALINGS = ("global", "whiten")
+#: Whitening adds this share of the largest eigenvalue to every eigenvalue before inverting, so
+#: that directions with almost no variance are not blown up.
+WHITENING_EPS = 0.01
+
+
+def whitening(x: np.ndarray, eps: float = WHITENING_EPS) -> tuple[np.ndarray, np.ndarray]:
+    """ZCA whitening of features ``x`` (N, F): the mean (F,) and a matrix W (F, F) such that
+    (x - mean) W has (nearly) the identity as covariance and stays closest to x."""
+    x = x.astype(np.float64)
+    mean = x.mean(0)
+    lam, U = np.linalg.eigh(np.cov(x - mean, rowvar=False))             # C = U diag(λ) Uᵀ
+    return mean, U @ np.diag(1 / np.sqrt(lam + eps * lam.max())) @ U.T  # W = U diag(1/√(λ+ε)) Uᵀ
+
+
+def check_vision_scaling(name: str) -> None:
+    """Raise a ValueError naming the allowed scalings unless ``name`` is one of them."""
+    if name not in VISION_SCALINGS:
+        raise ValueError(f"unknown vision_scaling {name!r}; choose one of: {', '.join(VISION_SCALINGS)}")
+
+
+def _whiten(x: np.ndarray, white: tuple | None) -> np.ndarray:
+    """Visual features ``x`` (..., 30) whitened with ``white = (mean, W)``; unchanged if None."""
+    if white is None:
+        return x
+    mean, W = (np.asarray(a) for a in white)
+    return ((x - mean) @ W).astype(np.float32)                              # z = (x - mean) W
+
+
+@dataclass
+class Normaliser:
+    """Min/max scaling of each modality to [-1, 1] (one global min and max per modality).
+
+    Deviation from paper: the authors take min/max over train and test
+    together; we use the training split only, so the test set stays unseen.
+    With ``vision_scaling="whiten"`` the visual features of both views are first
+    whitened with one transform (:func:`whitening`, fitted on NICO's own view of
+    the training split), then scaled with the min and max of NICO's own view:
+    one picture means the same numbers in both views.
+    """
+
+    joints: tuple[float, float]
+    vision: tuple[float, float]
+    vision_opposite: tuple[float, float]
+    #: with whitening: (mean, W) as nested tuples, shared by both views
+    whitening: tuple | None = None
+
+    @classmethod
+    def fit(cls, data: PGAEDataset, vision_scaling: str = "global") -> "Normaliser":
+        """Statistics from the valid steps of ``data`` (pass the training split).
+
+        ``vision_scaling``: ``"global"`` (the authors': one min and max over all visual
+        features) or ``"whiten"`` (whitened first: every direction of the 30-d feature
+        space gets about the same variance, then one min and max).
+        """
+        check_vision_scaling(vision_scaling)
+        data.check_finite()
+        m = data.mask
+        white = None
+        if vision_scaling == "whiten":
+            mean, W = whitening(data.vision[m])                                   # NICO's view, (30,), (30, 30)
+            white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
+
+        def lo_hi(name: str, x: np.ndarray) -> tuple[float, float]:
+            lo, hi = float(x[m].min()), float(x[m].max())
+            if not lo < hi:
+                raise DataFormatError(f"{data.source or 'dataset'}: {name} are "
+                                      f"constant ({lo:g}) in the training samples: "
+                                      "nothing to scale")
+            return lo, hi
+        vision = lo_hi("visual features", _whiten(data.vision, white))
+        # Whitened, the opposite view takes NICO's view's min and max too. With a min and max of its
+        # own, a few directions in which only that view varies set its scale and squeezed the opposite
+        # agent's motion into half the range, and PGAE-opposite described less (A2, "Visual features").
+        opposite = vision if white else lo_hi("opposite views", data.vision_opposite)
+        return cls(lo_hi("joints", data.joints), vision, opposite, white)
+
+    def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
+        if self.whitening is None:
+            return self._scale(x, getattr(self, key))
+        lo, hi = (np.float64(v) for v in getattr(self, key))                # scaled in float64
+        return self._scale(_whiten(x, self.whitening), (lo, hi))
+
+    @staticmethod
+    def _scale(x: np.ndarray, lo_hi: tuple[float, float]) -> np.ndarray:
+        lo, hi = lo_hi
+        return (2.0 * (x - lo) / (hi - lo) - 1.0).astype(np.float32)  # x' = 2 (x - min) / (max - min) - 1
+
+    def joints_to_model(self, x: np.ndarray) -> np.ndarray:
+        """Joints in the data's own units -> the model's [-1, 1]."""
+        return self._scale(x, self.joints)
+
+    def vision_to_model(self, x: np.ndarray, opposite: bool = False) -> np.ndarray:
+        """Visual features (NICO's view, or the opposite agent's) -> the model's [-1, 1]."""
+        return self._vision(x, "vision_opposite" if opposite else "vision")
+
+    def joints_to_data(self, x: np.ndarray | torch.Tensor) -> np.ndarray | torch.Tensor:
+        """Inverse of the joint scaling: [-1, 1] -> the data's own units."""
+        lo, hi = self.joints
+        return (x + 1.0) * (hi - lo) / 2.0 + lo
+
+    def tensors(self, data: PGAEDataset, device: torch.device | str = "cpu") -> dict[str, torch.Tensor]:
+        """Normalised tensors of a dataset on ``device``, padded steps set to 0."""
+        m = data.mask[..., None]
+        return {
+            "joints": torch.from_numpy(self._scale(data.joints, self.joints) * m).to(device),
+            "vision": torch.from_numpy(self._vision(data.vision, "vision") * m).to(device),
+            "vision_opposite": torch.from_numpy(self._vision(data.vision_opposite, "vision_opposite") * m).to(device),
+            "lengths": torch.from_numpy(data.lengths.astype(np.int64)).to(device),
+            "descriptions": torch.from_numpy(data.descriptions.astype(np.int64)).to(device),
+        }
+
+    def state_dict(self) -> dict:
+        state = {"joints": list(self.joints), "vision": list(self.vision),
+                 "vision_opposite": list(self.vision_opposite)}
+        if self.whitening is not None:
+            mean, W = self.whitening
+            state["whitening"] = [list(mean), [list(row) for row in W]]
+        return state
+
+    @classmethod
+    def from_state_dict(cls, state: dict) -> "Normaliser":
+        white = state.get("whitening")
+        if white is not None:
+            mean, W = white
+            white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
+        return cls(*(tuple(float(x) for x in state[k]) for k in ("joints", "vision", "vision_opposite")), white)
+
+
+def from_recordings(recordings: Iterable[tuple[Pattern, str, np.ndarray, np.ndarray, np.ndarray]],
+                    source: str) -> PGAEDataset:
+    """A :class:`PGAEDataset` from recordings ``(pattern, id, joints (n, 5), vision (n, 30), opposite (n, 30))``.
+
+    Pads every recording to ``MAX_STEPS`` and derives the descriptions, split,
+    action and arrangement from its pattern.
+    """
+    rows: dict[str, list] = {k: [] for k in _ARRAYS}
+    for pattern, sample_id, joints, vision, opposite in recordings:
+        pad = ((0, MAX_STEPS - len(joints)), (0, 0))
+        rows["joints"].append(np.pad(joints, pad))
+        rows["vision"].append(np.pad(vision, pad))
+        rows["vision_opposite"].append(np.pad(opposite, pad))
+        rows["lengths"].append(len(joints))
+        rows["descriptions"].append(pattern.descriptions())
+        rows["pattern"].append(pattern.number)
+        rows["is_test"].append(pattern.is_test)
+        rows["ids"].append(sample_id)
+        rows["action"].append(pattern.code)
+        rows["arrangement"].append(f"{pattern.left}+{pattern.right}")
+    arrays = {k: np.asarray(v) for k, v in rows.items()}
+    for k in ("joints", "vision", "vision_opposite"):
+        arrays[k] = arrays[k].astype(np.float32)
+    return PGAEDataset(**arrays, source=source)
+
+
+def description_text(indices: np.ndarray) -> str:
+    """Word indices of one description -> text."""
+    return " ".join(VOCABULARY[int(i)] for i in indices)
+
+
+__all__ = ["PGAEDataset", "Normaliser", "DataFormatError", "from_recordings", "description_text", "JOINT_DIM",
+           "VISION_DIM"]

@@ -1,0 +1,134 @@
+"""The authors' data: a reader for the text files of their public repository (oo222bs/PGAE).
+
+Paper, Sec. 4 (Dataset). The authors publish their recordings as one text file
+per sample and modality under ``target/{behavior,vision,vision_opp,language}_{train,test}/DATE/``,
+with ``actions.txt`` and ``arrangements.txt`` (one line per pattern) beside
+``target/``. :func:`load_original` reads them into a :class:`~pgae_lite.data.dataset.PGAEDataset`
+and raises :class:`~pgae_lite.data.dataset.DataFormatError` naming what was expected
+when anything is missing or malformed: a file and its line for a short or long
+row, a value that is not a finite number or lies far outside the data's range,
+a language row that is not one-hot (:mod:`pgae_lite.data.checks`), and a
+``vocabulary.txt`` whose words differ from :data:`pgae_lite.world.words.VOCABULARY`.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+from pgae_lite.world.words import VOCABULARY
+from pgae_lite.world.patterns import MAX_STEPS, Pattern
+from pgae_lite.data.checks import (JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range,
+                            check_vocabulary, read_rows)
+
+_SUBTREES = ("behavior", "vision", "vision_opp", "language")
+
+
+def load_original(path: str | Path) -> PGAEDataset:
+    """Read the authors' dataset (the folder holding ``target/`` and ``actions.txt``).
+
+    Raises :class:`~pgae_lite.data.dataset.DataFormatError` naming what was expected when the folder,
+    a sub-tree or a file is missing or malformed.
+    """
+    root = Path(path).expanduser()
+    if (root / "target").is_dir():
+        target = root / "target"
+    elif root.name == "target" and root.is_dir():
+        target, root = root, root.parent
+    else:
+        raise DataFormatError(
+            f"{root} is not the authors' PGAE data folder: expected a folder containing 'target/' "
+            f"with sub-folders {', '.join(s + '_train' for s in _SUBTREES)} (and *_test), and "
+            "'actions.txt' / 'arrangements.txt' beside it (public repository oo222bs/PGAE)")
+    for sub in _SUBTREES:
+        for split in ("train", "test"):
+            if not (target / f"{sub}_{split}").is_dir():
+                raise DataFormatError(f"missing folder {target / f'{sub}_{split}'}")
+    pattern_info = _read_patterns(root)
+    check_vocabulary(root)
+
+    rows: dict[str, list] = {k: [] for k in (
+        "joints", "vision", "vision_opposite", "lengths", "descriptions", "pattern", "is_test",
+        "ids", "action", "arrangement")}
+    for split in ("train", "test"):
+        for date_dir in sorted((target / f"behavior_{split}").iterdir()):
+            for f in sorted(date_dir.glob("target*.txt")):
+                rel = f"{date_dir.name}/{f.stem}"
+                joints = read_rows(f, 5)
+                check_range(f, joints, *JOINT_BOUNDS, "joint")
+                n = len(joints)
+                vision, opposite = (_read_vision(target / f"{v}_{split}" / f"{rel}.txt")
+                                    for v in ("vision", "vision_opp"))
+                lang_file = target / f"language_{split}" / f"{rel}.txt"
+                lang = read_rows(lang_file, len(VOCABULARY))
+                check_one_hot(lang_file, lang)
+                if len(vision) != n or len(opposite) != n or not 0 < n <= MAX_STEPS:
+                    raise DataFormatError(
+                        f"{f}: joints, vision and opposite vision must have the same "
+                        f"number of steps (<= {MAX_STEPS}); got {n}, {len(vision)}, "
+                        f"{len(opposite)}")
+                if lang.shape[0] != 40:
+                    raise DataFormatError(f"{lang_file}: a language file has 40 "
+                                          "one-hot rows (8 x 5), found "
+                                          f"{lang.shape[0]}")
+                pattern = int(f.stem.replace("target", ""))
+                if pattern not in pattern_info:
+                    raise DataFormatError(f"{rel}: pattern {pattern} not listed in actions.txt")
+                words = _descriptions(lang_file, lang, pattern)
+                action, arrangement, split_name = pattern_info[pattern]
+                if split_name != split:
+                    raise DataFormatError(f"{rel}: actions.txt puts pattern {pattern} in {split_name}, found in {split}")
+                pad = ((0, MAX_STEPS - n), (0, 0))
+                rows["joints"].append(np.pad(joints, pad))
+                rows["vision"].append(np.pad(vision, pad))
+                rows["vision_opposite"].append(np.pad(opposite, pad))
+                rows["lengths"].append(n)
+                rows["descriptions"].append(words)
+                rows["pattern"].append(pattern)
+                rows["is_test"].append(split == "test")
+                rows["ids"].append(rel)
+                rows["action"].append(action)
+                rows["arrangement"].append(arrangement)
+    if not rows["ids"]:
+        raise DataFormatError(f"no samples found under {target}/behavior_train/DATE/target*.txt")
+    order = np.argsort(rows["ids"], kind="stable")  # by date, then pattern: a fixed order
+    arrays = {k: np.asarray(v)[order] for k, v in rows.items()}
+    return PGAEDataset(**arrays, source=f"original:{root}")
+
+
+def _read_vision(path: Path) -> np.ndarray:
+    vision = read_rows(path, 30)
+    check_range(path, vision, -VISION_LIMIT, VISION_LIMIT, "visual feature")
+    return vision
+
+
+def _descriptions(path: Path, lang: np.ndarray, pattern: int) -> np.ndarray:
+    """The 8 descriptions (8, 3) in a language file's rows, checked with its pattern."""
+    tokens = lang.argmax(1).reshape(8, 5)        # (8 alternatives, <BOS> w w w <EOS>)
+    expected = Pattern.from_number(pattern).descriptions()                  # (8, 3)
+    wrong = (tokens[:, [0, 4]] != 0).any(1) | (tokens[:, 1:4] != expected).any(1)
+    if wrong.any():
+        k = int(np.argmax(wrong))
+        said, meant = (" ".join(VOCABULARY[i] for i in words)
+                       for words in (tokens[k], [0, *expected[k], 0]))
+        raise DataFormatError(f"{path}, rows {5 * k + 1}-{5 * k + 5}: description "
+                              f"{k + 1} reads {said!r}, expected {meant!r} for pattern "
+                              f"{pattern}")
+    return tokens[:, 1:4]
+
+
+def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:
+    actions_file, arrangements_file = root / "actions.txt", root / "arrangements.txt"
+    for f in (actions_file, arrangements_file):
+        if not f.is_file():
+            raise DataFormatError(f"missing {f} (one line per pattern, from the authors' repository)")
+    actions = [line.split() for line in actions_file.read_text().splitlines() if line.strip()]
+    arrangements = [line.strip() for line in arrangements_file.read_text().splitlines() if line.strip()]
+    if len(actions) != len(arrangements) or any(len(a) != 2 for a in actions):
+        raise DataFormatError(f"{actions_file} must have 'ACTION-CUBE-SPEED train|test' per line, "
+                              f"as many lines as {arrangements_file}")
+    return {i: (a[0], arr, a[1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
+
+
+__all__ = ["load_original"]

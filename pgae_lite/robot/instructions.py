@@ -1,0 +1,143 @@
+"""Free-form instructions: the model is told a sentence instead of a description, and executes it.
+
+Paper, Sec. 3 and 5: PGAE-BERT "has the potential to recognise unseen natural
+language". :func:`execute_paraphrases` gives every test episode one of the
+held-out paraphrases of its own instruction (:mod:`pgae_lite.bert.paraphrases`,
+e.g. "Could you shove the crimson cube forward in a hurry" for "push red
+fast") and executes it both ways, through :func:`instruction_features`
+(PGAE-BERT's transformer reads any text; PGAE's LSTM only its vocabulary, and
+says which words it does not know) and the paper's execute with those features
+(:func:`pgae_lite.evaluate.predict` with ``language=``, the open loop) as well
+as :func:`pgae_lite.robot.closedloop.closed_loop`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import torch
+from tqdm.auto import tqdm
+
+from pgae_lite.cae import ChannelSeparatedCAE
+from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.evaluate import predict
+from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
+from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.pretrained import check_texts, input_text
+from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
+from pgae_lite.data.simulated import DatasetConfig
+
+
+@torch.no_grad()
+def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
+    """Instructions -> the language encoder's features under ``execute``, (B, D), for ``language=``.
+
+    PGAE-BERT's pretrained encoder reads any text, after the signal phrase
+    (``input_text("execute", text)``, as in training). PGAE's LSTM reads only
+    its vocabulary: every text must be a description (action colour speed),
+    else a :class:`~pgae_lite.world.words.LanguageError` names the unknown words.
+    """
+    texts, encoder = check_texts("instruction_features", texts), model.language_encoder
+    if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
+        return encoder.encode_texts([input_text("execute", t) for t in texts])
+    for t in texts:
+        try:
+            parse_description(t)
+        except LanguageError as e:
+            raise LanguageError(f"PGAE's LSTM language encoder reads only its vocabulary, in the order "
+                                f"action colour speed (PGAE-BERT reads free text): {e}") from e
+    device = next(model.parameters()).device
+    tokens = torch.tensor([[SIGNAL_TOKEN + signal_index("execute"), *(WORD_INDEX[w] for w in tokenize(t)), EOS]
+                           for t in texts], device=device)                                   # (B, 5)
+    return encoder(tokens, torch.full((len(texts),), 5, device=device))
+
+
+ROUTES = ("direct", "said back")
+
+
+def check_route(route: str) -> None:
+    """A ValueError naming the routes unless ``route`` is one of ``ROUTES``."""
+    if route not in ROUTES:
+        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
+
+
+@torch.no_grad()
+def say_back(model: PGAE, data: PGAEDataset, normaliser: Normaliser, texts: list[str]) -> list[str]:
+    """Each instruction said back in the dataset's words (``repeat language``; sample i of ``data``
+    carries text i, whose action the model is not shown), e.g. ``"push red fast"``."""
+    texts = check_texts("say_back", texts)
+    if not hasattr(model.language_encoder, "encode_texts"):
+        raise ValueError("saying back free text needs PGAE-BERT's pretrained encoder; PGAE's LSTM reads "
+                         "descriptions only")
+    language = model.language_encoder.encode_texts([input_text("repeat language", t) for t in texts])
+    return predict(model, data, normaliser, "repeat language", language=language).text
+
+
+def acted_on(said: list[str], texts: list[str]) -> list[str]:
+    """What ``route="said back"`` executes: the words said back where they are a description
+    (action colour speed; hyphens read as spaces), else the instruction itself."""
+    out = []
+    for back, text in zip(said, texts):
+        try:
+            parse_description(back)
+            out.append(back.replace("-", " "))   # "move up", as training wrote it for the transformer
+        except LanguageError:
+            out.append(text)
+    return out
+
+
+def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
+    """The paraphrase an episode is given: of its pattern's meaning, number ``variation`` mod how many there are.
+
+    With the 3 paraphrases per test instruction and 6 variations, each is used twice.
+    None: no paraphrase has that meaning.
+    """
+    pat = Pattern.from_number(pattern)
+    mine = [p for p in paraphrases if p.meaning == (pat.action, pat.colour, pat.speed)]
+    return mine[variation % len(mine)] if mine else None
+
+
+def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data: PGAEDataset,
+                        paraphrases: list[Paraphrase] | None = None, split: str = "test", *,
+                        limit: int | None = None, closed: bool = True, config: DatasetConfig | None = None,
+                        tracking: bool = True, progress: bool = True, route: str = "direct") -> pd.DataFrame:
+    """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
+
+    Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
+    :func:`~pgae_lite.bert.paraphrases.load_paraphrases`) is told one
+    (:func:`paraphrase_of`), encoded by :func:`instruction_features`: PGAE-BERT
+    reads it, PGAE's LSTM raises a LanguageError naming the unknown words before
+    anything runs. Then, as in :func:`~pgae_lite.robot.closedloop.compare`: the paper's
+    execute (:func:`~pgae_lite.evaluate.predict` with ``language=``) run in the
+    simulator (``open_*`` columns) and, if ``closed``,
+    :func:`~pgae_lite.robot.closedloop.closed_loop` (``closed_*``). nRMSE (%) is against
+    the recorded joints of the episode, the intended action. ``limit``: that many
+    episodes, evenly spread. ``route``: ``"direct"`` (the paper's: the instruction's
+    features) or ``"said back"`` (:func:`say_back`, then those words; the ``acted_on``
+    column).
+    """
+    check_route(route)
+    paraphrases = load_paraphrases() if paraphrases is None else paraphrases
+    subset = data.split(split)
+    told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
+    rows = np.flatnonzero([t is not None for t in told])
+    if not len(rows):
+        raise ValueError(f"no paraphrase has the meaning of any {split} episode")
+    rows = rows[spread(len(rows), limit)]
+    episodes, told = subset.subset(rows), [told[i] for i in rows]
+    texts = [t.text for t in told]
+    if route == "said back":
+        texts = acted_on(say_back(model, episodes, normaliser, texts), texts)
+    language = instruction_features(model, texts)                             # (N, D)
+    planned = predict(model, episodes, normaliser, "execute", language=language).joints   # the paper's execute
+    joint_range = data.joint_range()
+    return pd.DataFrame([
+        {**execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
+                           language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
+         "meaning": " ".join(told[k].meaning), "acted_on": texts[k]}
+        for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
+
+
+__all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of", "execute_paraphrases"]

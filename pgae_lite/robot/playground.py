@@ -1,0 +1,350 @@
+"""The playground: choose a task, an episode or a sentence, and see what PGAE does.
+
+Paper, Sec. 3 ("Signals") and Sec. 4 (Table 1's tasks). One model does every
+task; the signal at the start of its language input picks which. :func:`play`
+runs one signal on one recorded episode of our simulator and keeps all there is
+to see:
+
+    episode = the recording of (arrangement, action), or of the description typed
+    batch   = make_batch(episode, signal, words)           what the task reads (signals.py)
+    out     = model(batch)                                 generated words, joints, GMU gate z
+    rollout = the simulator executes the predicted joints  (closedloop.open_loop / closed_loop)
+
+Text. Under ``execute`` and ``repeat language`` the model reads the words: a
+typed description (``action colour speed``, any synonym) replaces the
+episode's and picks the episode itself, the action it names in the chosen
+arrangement. PGAE's LSTM reads only those 22 words; PGAE-BERT's transformer
+reads any text (paper, Sec. 3), then the chosen action is the one meant.
+Under ``describe`` and ``repeat action`` the model reads no words, and a typed
+description only picks the episode. Bad text raises a
+:class:`~pgae_lite.world.words.LanguageError` that says what is wrong.
+
+:class:`Playground` is the ipywidgets front end: it only collects the choices,
+calls :func:`play` and shows the result, or the error's message.
+"""
+from __future__ import annotations
+
+import html
+import io
+import textwrap
+from dataclasses import dataclass
+from typing import Mapping
+
+import matplotlib.pyplot as plt
+import numpy as np
+import torch
+from matplotlib.figure import Figure
+
+from pgae_lite.world import patterns
+from pgae_lite.cae import ChannelSeparatedCAE
+from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
+from pgae_lite.config import PROFILES
+from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.robot.instructions import acted_on, check_route
+from pgae_lite.world.words import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
+    parse_description, tokenize
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.bert.pretrained import input_text
+from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
+from pgae_lite.sim.record import Execution
+from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.util.checks import instance_of, positive_number, whole_number
+from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number,
+                                  check_objects, check_playground)
+from pgae_lite.viz import animate_frames, plot_joints
+
+#: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
+PLAY_SIGNALS: tuple[str, ...] = ("describe", "execute", "repeat action", "repeat language")
+#: The 12 actions of an arrangement, (action, cube side, speed); action k is pattern 72·(k // 6) + 6·arrangement + k % 6.
+ACTIONS: tuple[tuple[str, str, str], ...] = tuple((a, side, speed) for speed in ("slowly", "fast")
+                                                  for a, side in ACTION_SIDES)
+#: What the joints of each signal should be (the action decoder's target, from the recorded episode).
+TARGETS: dict[str, str] = {"describe": "the final recorded pose, held", "execute": "the recorded joints",
+                           "repeat action": "the recorded joints", "repeat both": "the recorded joints",
+                           "repeat language": "the first recorded pose, held"}
+
+
+def arrangement_label(arrangement: int) -> str:
+    """E.g. ``"red left, blue right"`` for arrangement 0."""
+    left, right = ARRANGEMENTS[arrangement_number(arrangement)]
+    return f"{left} left, {right} right"
+
+
+def action_label(action: int) -> str:
+    """E.g. ``"push the left cube, slowly"`` for action 0."""
+    act, side, speed = ACTIONS[action_number(action)]
+    return f"{act} the {'left' if side == 'L' else 'right'} cube, {speed}"
+
+
+def pattern_number(arrangement: int, action: int) -> int:
+    """The pattern (0-143) of action ``action`` (0-11) in arrangement ``arrangement`` (0-11)."""
+    arrangement, action = arrangement_number(arrangement), action_number(action)
+    return patterns.pattern_number(action // 6, arrangement, action % 6)
+
+
+def simulator_config(data: PGAEDataset) -> DatasetConfig:
+    """The simulated dataset's config (found by the key in ``data.source``), else the book profile's."""
+    instance_of("data", data, PGAEDataset, "a PGAEDataset")
+    key = str(data.source).rpartition(":")[2]
+    return next((p.data for p in PROFILES.values() if p.data.key() == key), PROFILES["book"].data)
+
+
+def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[int, int]:
+    """(row in ``data``, simulator variation) of the ``variation``-th recording of ``pattern``."""
+    instance_of("data", data, PGAEDataset, "a PGAEDataset")
+    pattern = whole_number("pattern", pattern, 0, LAST_PATTERN)
+    variation = whole_number("variation", variation, 0)
+    rows = np.flatnonzero(data.pattern == pattern)
+    if variation >= len(rows):
+        p = Pattern.from_number(pattern)
+        have = sorted({arrangement_label(pattern_parts(int(q))[1]) for q in data.pattern})
+        what = f"pattern {pattern} ({p.action} {p.colour} {p.speed}, {p.left} left, {p.right} right)"
+        raise ValueError(f"this dataset has no recording of {what}; its arrangements are: {'; '.join(have)}"
+                         if not len(rows) else f"this dataset has {len(rows)} recording(s) of {what}, "
+                         f"so no variation {variation} (count from 0)")
+    row = int(rows[variation])
+    name = str(data.ids[row])                                   # "sim/PPP-V" for our simulator's episodes
+    return row, int(name.rsplit("-", 1)[1]) if name.startswith("sim/") else variation
+
+
+@dataclass
+class PlayResult:
+    """What one call of :func:`play` produced (joints in data units, steps 0..length-1)."""
+
+    signal: str
+    pattern: int
+    variation: int            # the simulator's variation of the episode
+    episode: str              # the episode's id in the dataset
+    told: str                 # the model's language input as text, e.g. "execute push red slowly"
+    words: str                # generated description, "" for <EOS> alone
+    correct: bool             # the paper's criterion for this signal
+    joints: np.ndarray        # (length, 5) predicted (closed loop: what the loop asked for)
+    target: np.ndarray        # (length, 5) what the signal asks for (see TARGETS)
+    nrmse: float              # % of the dataset's joint range, over steps 1..length-1
+    gate: np.ndarray          # (hidden,) GMU gate z: 1 lets the action through, 0 the language
+    rollout: Execution | None  # the simulator's execution of ``joints`` (None: not simulated)
+    loop: str | None = None   # "open", "closed" or None: how the simulator ran the joints
+    understood: str | None = None  # typed text said back (``repeat language``): what the model took it to mean
+
+    def summary(self) -> str:
+        """A few lines of plain text: task, episode, words, joint error, the simulator's verdict."""
+        p = Pattern.from_number(self.pattern)
+        expected = LANG_OUT[SIGNALS.index(self.signal)]
+        lines = [f"signal: {self.signal}   model reads: {self.told!r}",
+                 f"episode {self.episode}: {p.action} the {p.colour} cube {p.speed} ({p.left} left, {p.right} right)",
+                 f"words: {self.words or '<EOS>'!r} ({'right' if self.correct else 'wrong'}: expected "
+                 f"{'a description of the action' if expected else '<EOS> alone'})",
+                 f"joints: nRMSE {self.nrmse:.2f}% against {TARGETS[self.signal]}; "
+                 f"mean gate z {self.gate.mean():.2f} (0 = language, 1 = action)"]
+        if self.understood is not None:
+            lines.insert(1, f"I understood: {self.understood or '<EOS>'} (the typed text said back with repeat language)")
+        if self.rollout is not None:
+            verdict = "the cube moved as told" if self.rollout.passed else f"failed ({self.rollout.check.reason})"
+            held = self.signal in ("describe", "repeat language")
+            lines.append(f"robot, {self.loop} loop: {verdict}" + ("; this signal asks for a pose, not an action"
+                                                                   if held else ""))
+        return "\n".join(lines)
+
+    def figure(self) -> Figure:
+        """Predicted joints against the target (left) and the GMU gate per dimension of h (right)."""
+        fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.2), gridspec_kw={"width_ratios": [2, 1]})
+        plot_joints(self.joints, self.target, title=f"{self.signal}: target is {TARGETS[self.signal]}", ax=left)
+        right.bar(np.arange(len(self.gate)), self.gate, color=plt.cm.coolwarm(self.gate), width=1.0)
+        right.axhline(self.gate.mean(), color="black", lw=1, ls=":")
+        right.set(ylim=(0, 1), xlabel="dimension of h", ylabel="z (0 language, 1 action)",
+                  title=f"GMU gate, mean {self.gate.mean():.2f}")
+        fig.tight_layout()
+        return fig
+
+    def animation(self, every: int = 4, size: float = 3.0, dpi: int = 60):
+        """The robot executing the joints, from NICO's eye, and its joints (a matplotlib animation), or None."""
+        whole_number("every", every, 1), whole_number("dpi", dpi, 1)
+        positive_number("size", size)
+        if self.rollout is None:
+            return None
+        title = f"{textwrap.shorten(self.told, 36)}: {'done' if self.rollout.passed else 'failed'}"
+        return animate_frames({"NICO's eye": self.rollout.frames}, joints=self.rollout.measured, every=every,
+                              size=size, dpi=dpi, title=title)
+
+    def displays(self, every: int = 4) -> list:
+        """IPython display objects: the summary (HTML), the figure (PNG) and the animation (HTML)."""
+        from IPython.display import HTML, Image
+
+        fig = self.figure()
+        png = io.BytesIO()
+        fig.savefig(png, format="png", dpi=80)
+        plt.close(fig)                                  # shown once, as the PNG, not again by the backend
+        out = [HTML("<pre>" + html.escape(self.summary()) + "</pre>"), Image(data=png.getvalue(), format="png")]
+        anim = self.animation(every)
+        if anim is not None:
+            out.append(HTML(anim.to_jshtml()))          # frames embedded as PNGs: plays offline
+        return out
+
+    def show(self, every: int = 4) -> None:
+        """Display everything in a notebook."""
+        from IPython.display import display
+
+        display(*self.displays(every))
+
+
+def _reader_text(model: PGAE, signal: str, text: str) -> tuple[str, ...] | None:
+    """The typed description's words (synonyms kept); None for free text PGAE-BERT may read."""
+    try:
+        parse_description(text)
+        return tuple(tokenize(text))
+    except LanguageError as e:
+        if not hasattr(model.language_encoder, "encode_texts"):
+            raise LanguageError(f"PGAE's LSTM reads only its vocabulary, in the order action colour speed "
+                                f"(PGAE-BERT reads free text): {e}") from None
+        if not LANG_IN[SIGNALS.index(signal)]:
+            raise LanguageError(f"{signal!r} reads no words, so text can only pick the episode, and that takes "
+                                f"a description: {e}") from None
+        return None
+
+
+@torch.no_grad()
+def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, data: PGAEDataset,
+         signal: str = "execute", arrangement: int = 0, action: int = 0, text: str | None = None, *,
+         variation: int = 0, loop: str | None = "open", config: DatasetConfig | None = None,
+         route: str = "direct") -> PlayResult:
+    """Run ``model`` with one signal on the recorded episode of (``arrangement``, ``action``), or of ``text``.
+
+    ``text``: a description, or with PGAE-BERT any instruction (see the module
+    docstring). ``loop``: how the simulator executes the predicted joints:
+    ``"open"`` (:func:`~pgae_lite.robot.closedloop.open_loop`), ``"closed"`` (execute
+    only: :func:`~pgae_lite.robot.closedloop.closed_loop`, which needs ``cae``) or
+    None (no simulation). ``config``: the simulated dataset's (default: found
+    from ``data``). ``route``: free text under ``execute`` is executed ``"direct"``
+    or ``"said back"`` (its readback's words: :mod:`pgae_lite.robot.instructions`). Raises LanguageError or ValueError (a TypeError for a wrong type),
+    with a readable message, for a bad signal, text, choice or object.
+    """
+    check_objects(model, cae, normaliser, data, config)
+    pattern_number(arrangement, action)                    # checks both
+    instance_of("text", text, str, "a description (a string)", optional=True)
+    signal, text = normalise_signal(signal), (text or "").strip()
+    check_route(route)
+    if loop not in ("open", "closed", None):
+        raise ValueError(f"unknown loop {loop!r}; the options are: 'open', 'closed', None")
+    if loop == "closed" and (signal != "execute" or cae is None):
+        raise ValueError("the closed loop runs the signal execute, with the CAE: the model writes each step's "
+                         "joints from what its camera sees (choose execute, or the open loop)")
+    words = _reader_text(model, signal, text) if text else None
+    pattern = pattern_for(text, arrangement) if words else pattern_number(arrangement, action)
+    row, sim_variation = find_episode(data, pattern, variation)
+    device = next(model.parameters()).device
+    tensors = normaliser.tensors(data.subset([row]), device)
+    if words:                                              # the reader's words replace the episode's
+        tensors["descriptions"][:] = torch.tensor([WORD_INDEX[w] for w in words], device=device)
+    said = text or description_text(tensors["descriptions"][0, 0].cpu().numpy())   # the words the task may read
+    reads_words = LANG_IN[SIGNALS.index(signal)]
+    lookup = getattr(model.language_encoder, "word_lookup", None)   # the variant: unknown words via WordNet
+    told = input_text(signal, (lookup.rewrite(said) if lookup and text else said) if reads_words else "")
+    free = bool(reads_words and text and words is None)   # PGAE-BERT reads the text as it is
+    language = model.language_encoder.encode_texts([told]) if free else None
+
+    model.eval()
+    zero = torch.zeros(1, dtype=torch.long)
+    understood = None
+    if reads_words and text:                               # readback: the same words, said back, no action shown
+        back_language = model.language_encoder.encode_texts([input_text("repeat language", said)]) if free else None
+        back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
+        understood = decode(back["logits"][0].argmax(-1).cpu())
+    if free and route == "said back" and signal == "execute":   # act on its own words
+        said = acted_on([understood], [said])[0]
+        told = input_text(signal, said)
+        language = model.language_encoder.encode_texts([told])
+    batch = make_batch(tensors, zero, signal_ids(signal, 1), zero)
+    out = model(batch, language=language)
+    length = int(data.lengths[row])
+    joints = normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], out["joints"]], 1))[0, :length]
+    target = normaliser.joints_to_data(torch.cat([batch.start_joints[:, None], batch.joint_target], 1))[0, :length]
+    joints, target = joints.cpu().numpy(), target.cpu().numpy()
+    generated = decode(out["logits"][0].argmax(-1).cpu())
+    expected = [tuple(VOCABULARY[w] for w in alt) for alt in Pattern.from_number(pattern).descriptions()]
+
+    config = config or simulator_config(data)
+    rollout = None
+    if loop == "open":
+        rollout = open_loop(joints, pattern, sim_variation, description=told, config=config, render=True)
+    elif loop == "closed":
+        rollout = closed_loop(model, cae, normaliser, pattern, sim_variation, said, config=config,
+                              language=language, steps=length)
+        joints = rollout.joints
+    nrmse = 100 * float(np.sqrt(np.mean((joints[1:] - target[1:]) ** 2))) / data.joint_range()
+    return PlayResult(signal, pattern, sim_variation, str(data.ids[row]), told, generated,
+                      is_correct(generated, expected if LANG_OUT[SIGNALS.index(signal)] else None),
+                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood)
+
+
+class Playground:
+    """ipywidgets front end of :func:`play`: choose, press Run, see the result (or what was wrong).
+
+    ``models`` maps a name to ``(model, normaliser)``, e.g.
+    ``{"PGAE": (pgae.model, pgae.normaliser)}``. The last result is kept in
+    ``self.result``, the last error message in ``self.message``; the widgets
+    are attributes (``signal``, ``arrangement``, ``action``, ``text``, ``button``,
+    ``output``...), so a test can set them and call ``button.click()``.
+    ``signal``, ``arrangement`` and ``action`` are the first choices shown.
+    """
+
+    def __init__(self, models: Mapping[str, tuple[PGAE, Normaliser]], cae: ChannelSeparatedCAE | None,
+                 data: PGAEDataset, *, config: DatasetConfig | None = None, every: int = 4,
+                 signal: str = "execute", arrangement: int | None = None, action: int = 0):
+        import ipywidgets as w
+
+        check_playground(models, cae, data, config, every, signal, arrangement, action,
+                         PLAY_SIGNALS)
+        self.models, self.cae, self.data, self.config, self.every = dict(models), cae, data, config, every
+        self.result: PlayResult | None = None
+        self.message = ""
+        arrangements = sorted({pattern_parts(int(p))[1] for p in data.pattern})   # those the dataset recorded
+        variations = int(np.bincount(data.pattern).max())
+        self.model = w.Dropdown(options=list(self.models), description="model")
+        self.signal = w.ToggleButtons(options=PLAY_SIGNALS, value=normalise_signal(signal), description="signal")
+        self.arrangement = w.Dropdown(options=[(arrangement_label(a), a) for a in arrangements],
+                                      value=arrangements[0] if arrangement is None else arrangement,
+                                      description="cubes")
+        self.action = w.Dropdown(options=[(action_label(k), k) for k in range(len(ACTIONS))], value=action,
+                                 description="action")
+        self.variation = w.Dropdown(options=list(range(variations)), description="variation")
+        self.text = w.Text(description="or say", placeholder="e.g. push red slowly (PGAE-BERT: any sentence)",
+                           layout=w.Layout(width="32em"))
+        self.loop = w.Dropdown(options=[("open loop", "open"), ("closed loop (execute)", "closed"), ("no robot", None)],
+                               description="robot")
+        self.route = w.Dropdown(options=[("what it said back", "said back"), ("the sentence", "direct")],
+                                description="act on")            # free text under execute (PGAE-BERT)
+        self.button = w.Button(description="Run", button_style="primary", icon="play")
+        self.output = w.Output()
+        self.button.on_click(self.run)
+        self.widget = w.VBox([w.HBox([self.model, self.loop]), self.signal, w.HBox([self.arrangement, self.action]),
+                              w.HBox([self.text, self.variation]), self.route, self.button, self.output])
+
+    def run(self, _button=None) -> None:
+        """Call :func:`play` with the widgets' values and put what it made (or the error) in ``output``."""
+        from IPython.display import HTML
+
+        self.output.outputs = ()                           # works with and without a kernel
+        self.result, self.message = None, ""
+        self.button.disabled, self.button.description = True, "Running..."
+        model, normaliser = self.models[self.model.value]
+        try:
+            self.result = play(model, self.cae, normaliser, self.data, self.signal.value, self.arrangement.value,
+                               self.action.value, self.text.value, variation=self.variation.value,
+                               loop=self.loop.value, config=self.config, route=self.route.value)
+            shown = self.result.displays(self.every)
+        except (ValueError, PGAELiteError) as e:   # the reader's choice, not a bug
+            self.message = str(e)
+            shown = [HTML(f'<p style="color:#a40000"><b>Cannot run this:</b> {html.escape(self.message)}</p>')]
+        finally:
+            self.button.disabled, self.button.description = False, "Run"
+        for item in shown:
+            self.output.append_display_data(item)
+
+    def _repr_mimebundle_(self, **kwargs):
+        return self.widget._repr_mimebundle_(**kwargs)
+
+
+__all__ = ["ACTIONS", "PLAY_SIGNALS", "PlayResult", "Playground", "action_label", "arrangement_label",
+           "find_episode", "pattern_number", "play", "simulator_config"]

@@ -1,0 +1,207 @@
+"""From nothing to a dataset PGAE learns from: simulator -> CAE -> visual features.
+
+Paper, Sec. 4 (dataset) and Sec. 3 (visual features from a channel-separated
+CAE), on our simulated data. Each heavy step is cached, keyed by its config,
+so every chapter can call :func:`simulated_dataset` and get in seconds what an
+earlier chapter (or ``python -m pgae_lite simulate``) already made:
+
+1. :func:`pgae_lite.data.simulated.generate` records the episodes;
+2. :func:`trained_cae` trains the CAE on frames of the training episodes only;
+3. :func:`simulated_dataset` encodes every frame of both views into 30
+   features and returns a :class:`~pgae_lite.data.dataset.PGAEDataset`;
+4. :func:`trained_pgae` trains one of Table 1's models on it (PGAE, PGAE-BERT,
+   or the model of PGAE-self / PGAE-opposite), cached the same way;
+   :func:`trained_pgaes` trains several side by side, one per CPU core.
+"""
+from __future__ import annotations
+
+import os
+import time
+import warnings
+from concurrent.futures import ProcessPoolExecutor
+from multiprocessing import get_context
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable
+
+import numpy as np
+
+from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
+from pgae_lite.config import TRAININGS, get_profile, profile_name, training_profile
+from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+from pgae_lite.bert.phrase_lexicon import training_lexicon
+from pgae_lite.bert.phrasings import phrasings_digest
+from pgae_lite.data.simulated import DatasetConfig, generate, to_dataset, training_frames
+from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest
+
+if TYPE_CHECKING:
+    from pgae_lite.train.loop import Trained
+
+BUSY_POLL_SECONDS = 5      # how often trained_pgae looks whether another process's training has ended
+
+
+def _stem(data: DatasetConfig, cae: CAEConfig) -> str:
+    """The cache name of the episodes of ``data`` seen through a CAE trained with ``cae``: two digests."""
+    return f"{data.key()}-{config_digest(cae.to_dict())}"
+
+
+def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
+    """Where the CAE trained on ``data`` with ``cae`` is cached."""
+    return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
+
+
+def trained_cae(profile: str | None = None, device: str | None = None, progress: bool = True,
+                workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
+    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
+    prof = get_profile(profile)                  # None: the default profile (config.profile_name)
+    data, cae = prof.data, prof.cae
+    generate(data, workers=workers, progress=progress)
+    return cached_cae(cae_path(data, cae), cae,
+                      lambda: training_frames(data, cae.frame_stride), device, progress)
+
+
+def cached_cae(path: Path, cae: CAEConfig, frames: Callable[[], np.ndarray],
+               device: str | None = None, progress: bool = True
+               ) -> tuple[ChannelSeparatedCAE, list[dict]]:
+    """The CAE cached at ``path``, else one trained with ``cae`` on ``frames()``."""
+    if path.exists():  # the path is keyed by both configs: no need to read the frames again
+        try:
+            model, ckpt = load_cae(path, device)
+            if ckpt["config"] == cae.to_dict():
+                return model, ckpt["history"]
+            raise ValueError(f"config {ckpt['config']} differs from {cae.to_dict()}")
+        except Exception as e:  # a damaged or foreign file: train again rather than use it
+            warnings.warn(f"{path}: cannot use this cached CAE ({e}); training it again", stacklevel=2)
+            path.unlink()
+    return train_cae(frames(), cae, device, progress, out_path=path)
+
+
+def simulated_dataset(profile: str | None = None, device: str | None = None, progress: bool = True,
+                      workers: int | None = None) -> PGAEDataset:
+    """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
+    prof = get_profile(profile)
+    data, cae_config = prof.data, prof.cae
+    path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
+
+    def make() -> PGAEDataset:
+        model, _ = trained_cae(prof.name, device, progress, workers)
+        return to_dataset(data, lambda frames: extract_features(model, frames),
+                          progress)
+    return cached_dataset(path, make)
+
+
+def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
+    """The dataset cached at ``path``, else ``make()``'s, saved there."""
+    if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite
+        try:
+            return PGAEDataset.load(path, fingerprint=path.stem)
+        except DataFormatError as e:
+            warnings.warn(f"{e}; computing the features again", stacklevel=2)
+    dataset = make()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    dataset.save(path, fingerprint=path.stem)
+    return dataset
+
+
+def _model_folder(prof, training: str) -> Path:
+    """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
+    (and, for a training on phrasings, the sentences' own)."""
+    name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
+    if prof.train.phrasings:   # "-b2": the bank encodes only the signals that read phrasings (other rounding)
+        name += "-" + phrasings_digest(prof.train.phrasings, prof.train.seed,
+                                       training_lexicon(prof.train.phrasing_words)) + "-b2"
+    return cache_dir() / "pgae" / name
+
+
+def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
+                 device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
+    """A model of one training (for a row of Table 1) on the profile's simulated data, cached.
+
+    Loaded from the cache if it was trained before.
+
+    ``training`` is one of :data:`pgae_lite.config.TRAININGS` (``"PGAE"``,
+    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
+    ``train_overrides`` change the profile's training options (e.g. ``seed=1``); without
+    them it is the profile's recipe, the model every chapter and ``reproduce`` train.
+    An interrupted training resumes from its last checkpoint. When another process
+    is training the same model into the cache (two chapters run side by side), this
+    waits for it and then loads its model.
+    """
+    from pgae_lite.train.loop import CHECKPOINT, DataMismatchError, train
+
+    if training not in TRAININGS:
+        raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
+    name = profile_name(profile)
+    dataset = simulated_dataset(name, device, progress)
+    prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
+    folder = _model_folder(prof, training)
+    announced = False
+    while True:
+        try:
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+        # Damaged, or saved with other data statistics (the folder's name fixes the data and CAE, so an
+        # older pgae_lite scaled them otherwise): trained again, like the CAE.
+        except (CorruptCheckpointError, DataMismatchError) as e:
+            warnings.warn(f"cached model not used, training it again: {e}", stacklevel=2)
+            (folder / CHECKPOINT).unlink()
+        except FolderBusyError:           # another process trains this very model into the cache:
+            if progress and not announced:  # wait for it, then load what it trained
+                print(f"{training}: another process is training this model; waiting for it ...", flush=True)
+            announced = True
+            time.sleep(BUSY_POLL_SECONDS)
+
+
+def _train_alone(training: str, profile: str, seed: int) -> float:
+    """A worker of :func:`trained_pgaes`: one training on one thread; its training time (s)."""
+    import torch
+
+    torch.set_num_threads(1)
+    return trained_pgae(training, profile, seed, device="cpu", progress=False).seconds
+
+
+def trained_pgaes(trainings: list[str], profile: str | None = None, seed: int = 0, device: str | None = None,
+                  progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
+    """Several of :func:`trained_pgae`'s models, by training name; those not cached are trained side by side.
+
+    On a CPU the missing models train at the same time, each in its own process on
+    one thread, ``workers`` at once (default: one per core). These networks are
+    small: on the book's 2-core machine one training on both cores ran no faster
+    than on one (A2, "Where the time goes"), so two trainings side by side take
+    about the time of one. With a GPU, or one model to train, they train one after
+    another in this process, as :func:`trained_pgae` does. Workers are spawned, so a
+    script that calls this needs the usual ``if __name__ == "__main__":`` guard.
+    """
+    import torch
+
+    for training in trainings:
+        if training not in TRAININGS:
+            raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
+    name = profile_name(profile)
+    cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
+    todo = [t for t in dict.fromkeys(trainings) if not _finished(t, name, seed)]
+    workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
+    if cpu and workers > 1:
+        simulated_dataset(name, device, progress)         # recorded and encoded once, before the workers read it
+        if progress:
+            print(f"training {', '.join(todo)} side by side, {workers} at a time, one core each ...", flush=True)
+        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
+            for training, seconds in zip(todo, pool.map(_train_alone, todo, [name] * len(todo),
+                                                        [seed] * len(todo))):
+                if progress:
+                    print(f"{training}: trained in {seconds / 60:.1f} min", flush=True)
+    return {t: trained_pgae(t, name, seed, device, progress) for t in trainings}
+
+
+def _finished(training: str, profile: str, seed: int) -> bool:
+    """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
+    from pgae_lite.train.loop import CHECKPOINT, load_checkpoint
+
+    prof = training_profile(get_profile(profile, seed=seed), training)
+    folder = _model_folder(prof, training)
+    try:
+        return load_checkpoint(folder / CHECKPOINT)["epoch"] >= prof.train.epochs
+    except Exception:  # noqa: BLE001 -- missing or damaged: trained_pgae trains (again)
+        return False
+
+
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "cae_path", "cached_cae",
+           "cached_dataset"]

@@ -1,0 +1,237 @@
+"""Reproducing Table 1: train the rows' models, evaluate them, print them beside the paper's.
+
+Paper, Sec. 4 and Table 1. Four rows come from three trainings::
+
+    | row           | training                                   | evaluated on                  |
+    |---------------|--------------------------------------------|-------------------------------|
+    | PGAE          | LSTM language encoder, NICO's view only     | NICO's own actions            |
+    | PGAE-BERT     | frozen pretrained language encoder          | NICO's own actions            |
+    | PGAE-self     | NICO's or the opposite agent's view, 50/50  | NICO's own actions            |
+    | PGAE-opposite | the same model as PGAE-self                 | the opposite agent's actions  |
+
+``execute`` and ``repeat language`` show no action to the encoder beyond the
+first step, so PGAE-opposite shares those two cells with PGAE-self (as in the
+paper). With several seeds every cell is reported as mean ± standard deviation.
+
+Output folder layout (``out``)::
+
+    results.json                 every cell of every row and seed, mean and std, times
+                                 (strict JSON: a NaN or an infinity is written as null)
+    predictions.npz              the first row's predictions for the first seed
+    TRAINING-seedS/checkpoint.pt one folder per training and seed (resumable)
+    TRAINING-seedS/predictions-ROW.npz
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import statistics
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from pgae_lite.config import ROWS, TRAININGS, Profile, get_profile, training_profile  # TRAININGS: the README names it here
+from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.util.errors import ArgumentError
+from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table
+from pgae_lite.world.words import TEST_SIGNALS
+from pgae_lite.bert.pretrained import model_source
+from pgae_lite.train.loop import train
+from pgae_lite.util.storage import atomic_write, atomic_write_text
+from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
+
+
+SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
+CELLS = ("accuracy", "nrmse", "nrmse_padded")
+MAX_SEEDS = 100                                     # models per row: a sane count
+#: The command line's name of each argument :func:`check_arguments` checks.
+FLAGS = {"original_data": "--original-data", "rows": "--rows", "seed": "--seed",
+         "seeds": "--seeds", "epochs": "--epochs", "device": "--device",
+         "pretrained_model": "--pretrained-model", "out_dir": "--out"}
+
+
+def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
+    """``"all"``, a comma-separated string or a list of row names -> checked list (case-insensitive)."""
+    if rows is None:
+        return ["PGAE"]
+    instance_of("rows", rows, (str, list, tuple), "'all', a list or names and commas")
+    if isinstance(rows, str):
+        rows = list(ROWS) if rows.strip().lower() == "all" else rows.split(",")
+    if not rows:
+        raise ArgumentError(f"rows is empty; the rows are: {', '.join(ROWS)} or 'all'")
+    by_lower = {r.lower(): r for r in ROWS}
+    out = []
+    for r in rows:
+        name = by_lower.get(r.strip().lower()) if isinstance(r, str) else None
+        if name is None:
+            shown = r.strip() if isinstance(r, str) else r
+            raise ArgumentError(f"unknown row {shown!r}; the rows are: "
+                                f"{', '.join(ROWS)} (or 'all')")
+        if name not in out:
+            out.append(name)
+    return out
+
+
+def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained_model,
+                    out_dir, cli: bool = False) -> list[str]:
+    """:func:`reproduce`'s arguments checked before any data is read; returns the rows.
+
+    A bad one raises a one-sentence :class:`~pgae_lite.util.errors.PGAELiteError` that
+    names it as the command line does (:data:`FLAGS`) if ``cli``.
+    """
+    name = FLAGS if cli else {key: key for key in FLAGS}
+    rows = parse_rows(rows)
+    whole_number(name["seed"], seed, 0, MAX_SEED)
+    whole_number(name["seeds"], seeds, 1, MAX_SEEDS)
+    if seed + seeds - 1 > MAX_SEED:
+        raise ArgumentError(f"{name['seed']} {seed} with {name['seeds']} {seeds} "
+                            f"reaches seed {seed + seeds - 1}; seeds go up to "
+                            f"2**32 - 1 = {MAX_SEED}")
+    if epochs is not None:
+        whole_number(name["epochs"], epochs, 1)
+    torch_device(name["device"], device)
+    defaults = {"original_data": "our simulated data",
+                "out_dir": "runs/DATA-PROFILE-seedSEED"}
+    for key, value in (("original_data", original_data), ("out_dir", out_dir)):
+        instance_of(name[key], value, (str, os.PathLike), "a folder (str or Path)",
+                    optional=True)
+        if value is not None and not str(value).strip():
+            raise ArgumentError(f"{name[key]} is empty (an unset variable?); give a "
+                                f"folder, or leave {name[key]} out for the default: "
+                                f"{defaults[key]}")
+    if "PGAE-BERT" in rows:
+        model_source(pretrained_model)     # a missing model: refused before any data
+    elif pretrained_model is not None:
+        raise ArgumentError(f"{name['pretrained_model']} {pretrained_model!r} is "
+                            f"PGAE-BERT's language model, but the rows "
+                            f"({', '.join(rows)}) do not include PGAE-BERT; add it to "
+                            f"{name['rows']} or leave {name['pretrained_model']} out")
+    return rows
+
+
+def finite_or_null(obj) -> tuple[object, int]:
+    """``obj`` with each NaN or infinity replaced by None (JSON's null); their count."""
+    if isinstance(obj, float):
+        return (obj, 0) if math.isfinite(obj) else (None, 1)
+    if isinstance(obj, (dict, list, tuple)):
+        keys = list(obj) if isinstance(obj, dict) else range(len(obj))
+        pairs = [finite_or_null(obj[k]) for k in keys]
+        values = [v for v, _ in pairs]
+        clean = dict(zip(keys, values)) if isinstance(obj, dict) else values
+        return clean, sum(n for _, n in pairs)
+    return obj, 0
+
+
+def write_results(path: Path, report: dict) -> int:
+    """``report`` as strict JSON (NaN, infinities as null), atomically; their count."""
+    clean, nonfinite = finite_or_null(report)
+    atomic_write_text(path, json.dumps(clean, indent=2, allow_nan=False))
+    return nonfinite
+
+
+def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
+    """``S_ids``, ``S_text``, ``S_joints`` for each test signal S (spaces as ``_``), written atomically."""
+    arrays = {}
+    for signal, p in preds.items():
+        key = signal.replace(" ", "_")
+        arrays[f"{key}_ids"] = p.ids.astype(str)
+        arrays[f"{key}_text"] = np.asarray(p.text, dtype=str)
+        arrays[f"{key}_joints"] = p.joints
+    with atomic_write(path) as f:
+        np.savez_compressed(f, **arrays)
+
+
+def summarise(per_seed: list[dict[str, dict[str, float]]]) -> tuple[dict, dict]:
+    """Mean and standard deviation (0 for one seed) of every cell over seeds."""
+    mean = {s: {c: statistics.fmean(r[s][c] for r in per_seed) for c in CELLS} for s in TEST_SIGNALS}
+    std = {s: {c: statistics.stdev([r[s][c] for r in per_seed]) if len(per_seed) > 1 else 0.0 for c in CELLS}
+           for s in TEST_SIGNALS}
+    return mean, std
+
+
+def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Path,
+               profile: Profile, device: str | None = None, progress: bool = True,
+               pretrained_model: str | None = None) -> dict:
+    """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
+    for row in rows:
+        report["rows"][row] = {"training": ROWS[row][0], "paper": {
+            s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE[row].items()}, "seeds": {}}
+    for training in dict.fromkeys(ROWS[r][0] for r in rows):
+        for seed in seeds:
+            prof = training_profile(replace(profile, train=replace(profile.train, seed=seed)), training,
+                                    pretrained_model)
+            folder = out / f"{training}-seed{seed}"
+            trained = train(dataset, prof, out_dir=folder, device=device, progress=progress)
+            info = report["trainings"].setdefault(training, {"profile": prof.to_dict(), "train_seconds": {}})
+            info["train_seconds"][str(seed)] = trained.seconds
+            self_results = None
+            for row in (r for r in rows if ROWS[r][0] == training):
+                opposite = ROWS[row][1]
+                results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=opposite)
+                if opposite:
+                    if self_results is None:
+                        self_results, _ = evaluate(trained.model, dataset, trained.normaliser)
+                    results |= {s: self_results[s] for s in SHARED_WITH_SELF}
+                else:
+                    self_results = results
+                save_predictions(folder / f"predictions-{row}.npz", preds)
+                report["rows"][row]["seeds"][str(seed)] = results
+    for row in rows:
+        mean, std = summarise([report["rows"][row]["seeds"][str(s)] for s in seeds])
+        report["rows"][row] |= {"mean": mean, "std": std}
+    first = out / f"{ROWS[rows[0]][0]}-seed{seeds[0]}" / f"predictions-{rows[0]}.npz"
+    shutil.copyfile(first, out / "predictions.npz")
+    return report
+
+
+def reproduce(original_data: str | Path | None = None, profile: str | None = None, seed: int = 0,
+              out_dir: str | Path | None = None, epochs: int | None = None,
+              device: str | None = None, progress: bool = True, rows: str | list[str] | None = None,
+              seeds: int = 1, pretrained_model: str | None = None) -> dict:
+    """Table 1 from scratch: train (or resume) and evaluate the chosen rows; write and print the results.
+
+    ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
+    our simulated data (simulator -> CAE -> PGAE, each step cached). ``rows``: see
+    :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
+    per row are trained, with seeds ``seed, seed + 1, ...``. Every argument is checked
+    before any data is read (:func:`check_arguments`).
+    """
+    from pgae_lite.data.original import load_original
+
+    rows = check_arguments(original_data, rows, seed, seeds, epochs, device,
+                           pretrained_model, out_dir)
+    prof = get_profile(profile, **({} if epochs is None else {"epochs": epochs}))
+    if original_data is not None:
+        dataset, source = load_original(original_data), "original"
+    else:
+        from pgae_lite.runs.pipeline import simulated_dataset
+        dataset, source = simulated_dataset(prof.name, device, progress), "simulated"
+    default_out = f"runs/{source}-{prof.name}-seed{seed}"
+    out = Path(out_dir if out_dir is not None else default_out)
+    t0 = time.perf_counter()
+    report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,
+                        pretrained_model)
+    report |= {"data": dataset.source if original_data is None else str(original_data),
+               "wall_seconds": time.perf_counter() - t0}
+    nonfinite = write_results(out / "results.json", report)
+    print(format_table({f"{r} (ours)": report["rows"][r]["mean"] for r in rows},
+                       {f"{r} (ours)": r for r in rows},
+                       std={f"{r} (ours)": report["rows"][r]["std"] for r in rows} if seeds > 1 else None))
+    times = ", ".join(f"{t} {statistics.fmean(v['train_seconds'].values()):.0f} s"
+                      for t, v in report["trainings"].items())
+    print(f"\nprofile {prof.name}, seeds {report['seeds']}, mean training time: {times}; "
+          f"wrote {out / 'results.json'} and {out / 'predictions.npz'}")
+    if nonfinite:
+        print(f"note: {nonfinite} value(s) were not finite (NaN or infinite); "
+              "results.json holds null there")
+    return report
+
+
+__all__ = ["FLAGS", "MAX_SEEDS", "check_arguments", "finite_or_null", "parse_rows",
+           "reproduce", "run_table1", "save_predictions", "summarise", "write_results"]

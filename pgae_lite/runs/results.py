@@ -1,0 +1,196 @@
+"""Measured results as data: the committed result files that the benchmarks write (``results/*.json``).
+
+Every measured figure the book, the README and the notes quote (Table 1 of the
+paper's Sec. 4 on both datasets, closed-loop success, times) is read from a
+result file through this module, never typed by hand, so a quote cannot drift
+from its measurement. A result file is written by one of the scripts in
+``benchmarks/`` (``benchmarks/harness.py``) and says how it was made::
+
+    {"benchmark": "table1", "command": "python benchmarks/table1.py ...", "commit": "1a2b3c4",
+     "date": "2026-11-24T15:02:11+00:00", "machine": {...}, "profile": "book",
+     "seeds": [0, 1, 2], "seconds": 1234.5, "data": {...}}
+
+    >>> value("recipe_time", "recipes", "fast", "minutes")       # a figure
+    >>> quote("recipe_time", "recipes", "fast", "minutes", digits=1)   # the same, as text
+    >>> measured("recipe_time")                                   # when, where and how
+"""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from pgae_lite.world.words import TEST_SIGNALS
+
+RESULTS_ENV = "PGAE_LITE_RESULTS"
+
+
+def results_dir() -> Path:
+    """``$PGAE_LITE_RESULTS``, else the repository's ``results/`` (beside the package)."""
+    return Path(os.environ.get(RESULTS_ENV) or Path(__file__).resolve().parents[2] / "results")
+
+
+def names() -> list[str]:
+    """The result files there, by name (``table1-original`` for ``results/table1-original.json``)."""
+    return sorted(p.stem for p in results_dir().glob("*.json"))
+
+
+def load(name: str) -> dict:
+    """The whole result file ``results/<name>.json``."""
+    path = results_dir() / f"{name}.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"no result file {path}; the result files are: {', '.join(names()) or 'none'} "
+                                f"(set {RESULTS_ENV} to the folder that holds them)")
+    return json.loads(path.read_text())
+
+
+def value(name: str, *keys: str | int):
+    """One figure: ``load(name)["data"][keys[0]][keys[1]]...``; a wrong key names the ones there are."""
+    node, where = load(name)["data"], f"{name}.json: data"
+    for key in keys:
+        try:
+            node = node[key]
+        except (KeyError, IndexError, TypeError):
+            there = ", ".join(map(str, node)) if isinstance(node, dict) else f"{len(node)} items"
+            raise KeyError(f"{where} has no {key!r}; it has: {there}") from None
+        where += f"[{key!r}]"
+    return node
+
+
+def quote(name: str, *keys: str | int, digits: int = 2) -> str:
+    """A figure as text, ``digits`` after the point, thousands separated (``"1,234.50"``)."""
+    return f"{value(name, *keys):,.{digits}f}"
+
+
+def measured(name: str) -> str:
+    """When, where and how a result file was made, as one line of text."""
+    r = load(name)
+    m = r.get("machine", {})
+    threads = m.get("threads", "?")
+    where = f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, {threads} thread{'' if threads == 1 else 's'}"
+    if m.get("gpu"):
+        where += f", {m['gpu']}"
+    return (f"measured {r['date'][:10]} at commit {r['commit']} ({where}, torch {m.get('torch', '?')}, "
+            f"profile {r.get('profile')}, seeds {r.get('seeds')}) by `{r['command']}`")
+
+
+def table1_frame(name: str, rows: list[str] | None = None) -> pd.DataFrame:
+    """Table 1 from a ``benchmarks/table1.py`` result: per row, our median, min and max over seeds, the paper's.
+
+    Columns are (signal, "accuracy %" or "nRMSE %"); each row of the paper is followed by
+    ours: "median", "min", "max" (over seeds) and "paper".
+    """
+    data = value(name, "rows")
+    out = {}
+    for row in rows or list(data):
+        seeds = data[row]["seeds"]
+        for what in ("median", "min", "max", "paper"):
+            cells = {}
+            for i, signal in enumerate(TEST_SIGNALS):
+                for key, label in (("accuracy", "accuracy %"), ("nrmse", "nRMSE %")):
+                    if what == "paper":
+                        cells[(signal, label)] = data[row]["paper"][signal][0 if key == "accuracy" else 1]
+                    elif what == "median":
+                        cells[(signal, label)] = data[row]["stats"][signal][key]["median"]
+                    else:
+                        per_seed = [s[signal][key] for s in seeds.values()]
+                        cells[(signal, label)] = min(per_seed) if what == "min" else max(per_seed)
+            out[(row, what)] = cells
+    frame = pd.DataFrame(out).T
+    frame.columns = pd.MultiIndex.from_tuples(frame.columns)
+    return frame
+
+
+def table1_met(name: str) -> dict[str, bool]:
+    """Per row of a ``table1.py`` result: is every median cell at or better than the paper's?"""
+    return {row: all(all(v.values()) for v in r["verdict"].values()) for row, r in value(name, "rows").items()}
+
+
+def headline_table() -> str:
+    """The README's headline table (Markdown): Table 1's medians on the authors' data next to the paper's."""
+    data = value("table1-original", "rows")
+    head = ("| row | describe % | repeat language % | execute nRMSE % | repeat action nRMSE % |\n"
+            "|---|---|---|---|---|")
+    lines = [head]
+    for row, r in data.items():
+        stats, paper = r["stats"], r["paper"]
+        lines.append(f"| {row} | {stats['describe']['accuracy']['median']:.2f} ({paper['describe'][0]:.2f}) "
+                     f"| {stats['repeat language']['accuracy']['median']:.2f} ({paper['repeat language'][0]:.2f}) "
+                     f"| {stats['execute']['nrmse']['median']:.3f} ({paper['execute'][1]:.2f}) "
+                     f"| {stats['repeat action']['nrmse']['median']:.3f} ({paper['repeat action'][1]:.2f}) |")
+    seeds = load("table1-original")["seeds"]
+    lines.append(f"\nMedian over seeds {', '.join(map(str, seeds))} (the paper's figure in brackets); "
+                 f"{measured('table1-original')}.")
+    return "\n".join(lines)
+
+
+#: the Table 1 cells an ablation is judged on, (signal, measure): all but the accuracies of execute and
+#: repeat action, which only say that the model wrote <EOS> (100% in every run)
+ABLATION_CELLS = (("describe", "accuracy"), ("repeat language", "accuracy"), ("describe", "nrmse"),
+                  ("repeat language", "nrmse"), ("execute", "nrmse"), ("repeat action", "nrmse"))
+
+
+def ablation_frame(ablation: str, name: str = "ablations") -> pd.DataFrame:
+    """One of chapter 04's ablations against the recipe, from a ``benchmarks/ablations.py`` result.
+
+    Per Table 1 cell: the recipe's and the ablation's median over the seeds with their range
+    (min-max), and whether the two ranges are apart, i.e. whether the effect exceeds the
+    spread of the seeds ("yes, better" / "yes, worse" / "no").
+    """
+    runs = value(name, "runs")
+    there = sorted({r["ablation"] for r in runs} - {"recipe"})
+    if ablation not in there:
+        raise KeyError(f"{name}.json has no ablation {ablation!r}; it has: {', '.join(there)}")
+
+    def per_seed(who: str, signal: str, key: str) -> list[float]:
+        return sorted(r["table1"][signal][key] for r in runs if r["ablation"] == who)
+
+    def text(values: list[float], digits: int) -> str:
+        return f"{pd.Series(values).median():.{digits}f} ({values[0]:.{digits}f}-{values[-1]:.{digits}f})"
+
+    rows = {}
+    for signal, key in ABLATION_CELLS:
+        base, changed = per_seed("recipe", signal, key), per_seed(ablation, signal, key)
+        digits = 2 if key == "accuracy" else 3
+        higher = pd.Series(changed).median() > pd.Series(base).median()
+        better = higher if key == "accuracy" else not higher
+        apart = changed[0] > base[-1] or changed[-1] < base[0]
+        rows[f"{signal} {'accuracy' if key == 'accuracy' else 'nRMSE'} %"] = {
+            f"recipe ({len(base)} seeds)": text(base, digits),
+            f"{ablation} ({len(changed)} seeds)": text(changed, digits),
+            "beyond the seeds' spread": ("yes, better" if better else "yes, worse") if apart else "no"}
+    return pd.DataFrame(rows).T
+
+
+def ablation_verdict(frame: pd.DataFrame) -> str:
+    """In one sentence: which cells of an :func:`ablation_frame` differ beyond the spread of the seeds."""
+    verdicts = frame["beyond the seeds' spread"]
+    apart = [f"{cell.removesuffix(' %')} ({v.removeprefix('yes, ')})" for cell, v in verdicts.items() if v != "no"]
+    if not apart:
+        return "no cell of Table 1 differs from the recipe's by more than the spread of the seeds"
+    return "beyond the spread of the seeds: " + ", ".join(apart)
+
+
+README_START, README_END = "<!-- headline:start", "<!-- headline:end -->"
+
+
+def readme_with_headline(readme: str) -> str:
+    """``readme`` (the README's text) with its generated block replaced by :func:`headline_table`."""
+    if README_START not in readme or README_END not in readme:
+        raise ValueError(f"the README has no generated block ({README_START} ... {README_END})")
+    head, rest = readme.split(README_START, 1)
+    first_line, _ = rest.split("\n", 1)
+    _, tail = rest.split(README_END, 1)
+    return f"{head}{README_START}{first_line}\n{headline_table()}\n{README_END}{tail}"
+
+
+if __name__ == "__main__":
+    import sys
+
+    if sys.argv[1:] != ["--readme"]:
+        raise SystemExit("usage: python -m pgae_lite.runs.results --readme   (rewrites README.md's headline table)")
+    readme = Path(__file__).resolve().parents[2] / "README.md"
+    readme.write_text(readme_with_headline(readme.read_text()))
+    print(f"{readme}: headline table rewritten from {results_dir() / 'table1-original.json'}")

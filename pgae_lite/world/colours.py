@@ -1,0 +1,193 @@
+"""The world's colours, words and patterns, and how to extend them with a new colour.
+
+Not from the paper: the book's guided project "Teach NICO a new colour". The
+paper's world (Sec. 4, Dataset) has six cube colours, 23 words, 12 cube
+arrangements and 144 patterns; :data:`DEFAULT_WORLD` is exactly that world,
+built from :mod:`pgae_lite.world.words` and :mod:`pgae_lite.world.patterns`, and
+everything that takes a ``world`` (the simulator, the dataset cache, the
+model) behaves bit for bit as before when given it or nothing.
+
+:func:`with_colour` returns a larger world, never changing a module constant::
+
+    world = with_colour("orange", synonym="amber", rgba=(0.98, 0.50, 0.05, 1.0))
+
+- the word and its synonym are appended to the vocabulary (indices 23 and 24:
+  the paper's words keep theirs, so the old data stays valid);
+- each partner colour gives two new arrangements, (new, partner) and
+  (partner, new), appended after the 12, and each arrangement 12 new
+  patterns, numbered after the 144 (:data:`EXTENSION_NUMBERING`);
+- a test split of the new patterns in the paper's spirit: every meaning of
+  the new colour (action, speed) is held out in exactly one arrangement, on
+  both cube sides, so every word and action type is seen in training and
+  tested in a combination never trained (:func:`held_out`);
+- the RGBA of the new cube goes to the simulator (:mod:`pgae_lite.sim.scene`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Sequence
+
+import numpy as np
+
+from pgae_lite.world.words import DEFAULT_LEXICON, Lexicon, LanguageError, equivalent_descriptions
+from pgae_lite.world.patterns import (ACTION_SIDES, ARRANGEMENTS, NUMBERING, TEST_PATTERNS, Pattern,
+                       pattern_number, pattern_parts)
+from pgae_lite.util.storage import config_digest
+
+#: The paper's patterns: 0-143 (:data:`pgae_lite.world.patterns.NUMBERING`).
+PAPER_PATTERNS = 144
+#: How the patterns of an added arrangement (index 12 and up) are numbered.
+EXTENSION_NUMBERING = "144 + 12 * (arrangement - 12) + 6 * speed + action"
+#: The partner colours of a new colour unless told: one from each group of the paper.
+DEFAULT_PARTNERS = ("blue", "violet")
+
+RGBA = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class WorldPattern(Pattern):
+    """A :class:`~pgae_lite.world.patterns.Pattern` whose split and words are a world's."""
+
+    world: World | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def is_test(self) -> bool:
+        return self.number in self.world.test_patterns
+
+    def descriptions(self) -> np.ndarray:
+        """Word indices of the 8 equivalent descriptions (the world's), (8, 3)."""
+        lex = self.world.lexicon
+        alts = equivalent_descriptions(self.action, self.colour, self.speed, lex)
+        return np.array([[lex.word_index[w] for w in alt] for alt in alts])
+
+
+@dataclass(frozen=True)
+class World:
+    """Words, cube arrangements, test split, extra cube colours (default: the paper's).
+
+    ``palette`` holds the RGBA of colours the simulator does not know
+    (:data:`pgae_lite.sim.scene.CUBE_RGBA` has the paper's six).
+    """
+
+    lexicon: Lexicon = DEFAULT_LEXICON
+    arrangements: tuple[tuple[str, str], ...] = ARRANGEMENTS
+    test_patterns: frozenset[int] = TEST_PATTERNS
+    palette: tuple[tuple[str, RGBA], ...] = ()
+
+    @property
+    def n_patterns(self) -> int:
+        """Number of patterns: 144, plus 12 per added arrangement."""
+        return PAPER_PATTERNS + 12 * (len(self.arrangements) - len(ARRANGEMENTS))
+
+    @property
+    def new_patterns(self) -> tuple[int, ...]:
+        """The patterns beyond the paper's 144."""
+        return tuple(range(PAPER_PATTERNS, self.n_patterns))
+
+    def patterns_with(self, colour: str) -> tuple[int, ...]:
+        """The added patterns whose arrangement has a cube of ``colour``."""
+        cubes = {n: self.pattern(n) for n in self.new_patterns}
+        return tuple(n for n, p in cubes.items() if colour in (p.left, p.right))
+
+    def pattern_number(self, speed: int, arrangement: int, action: int) -> int:
+        """The paper's numbering to arrangement 11, then :data:`EXTENSION_NUMBERING`."""
+        if arrangement < len(ARRANGEMENTS):
+            return pattern_number(speed, arrangement, action)
+        k = arrangement - len(ARRANGEMENTS)                # the k-th added arrangement
+        return PAPER_PATTERNS + 12 * k + 6 * speed + action
+
+    def pattern_parts(self, number: int) -> tuple[int, int, int]:
+        """(speed, arrangement, action) of a pattern: the inverse of pattern_number."""
+        last = self.n_patterns - 1
+        if not isinstance(number, (int, np.integer)) or not 0 <= number <= last:
+            extra = (f", and {PAPER_PATTERNS}-{last} as {EXTENSION_NUMBERING}"
+                     if last >= PAPER_PATTERNS else "")
+            raise ValueError(f"pattern number {number!r} out of range; patterns are "
+                             f"0-143 ({NUMBERING}){extra}")
+        if number < PAPER_PATTERNS:
+            return pattern_parts(int(number))
+        k, rest = divmod(int(number) - PAPER_PATTERNS, 12)
+        return rest // 6, len(ARRANGEMENTS) + k, rest % 6
+
+    def pattern(self, number: int) -> WorldPattern:
+        """The pattern ``number`` (0 to :attr:`n_patterns` - 1) of this world."""
+        speed, arrangement, action = self.pattern_parts(number)
+        act, side = ACTION_SIDES[action]
+        left, right = self.arrangements[arrangement]
+        speed_word = ("slowly", "fast")[speed]
+        return WorldPattern(int(number), act, side, speed_word, left, right, world=self)
+
+    @cached_property
+    def rgba(self) -> dict[str, RGBA]:
+        """RGBA of the colours beyond the simulator's six."""
+        return dict(self.palette)
+
+    def to_dict(self) -> dict:
+        """Plain values (it names the cache entries of this world's data and models)."""
+        lex = self.lexicon
+        return {"vocabulary": list(lex.vocabulary),
+                "synonyms": [list(s) for s in lex.synonyms],
+                "colours": list(lex.colours),
+                "arrangements": [list(a) for a in self.arrangements],
+                "test_patterns": sorted(self.test_patterns),
+                "palette": [[c, list(v)] for c, v in self.palette]}
+
+    def key(self) -> str:
+        """Short digest of :meth:`to_dict`."""
+        return config_digest(self.to_dict())
+
+
+#: The paper's world: 23 words, 12 arrangements, 144 patterns, 36 of them test.
+DEFAULT_WORLD = World()
+
+
+def held_out(j: int, action: int, speed: int, arrangements: int) -> bool:
+    """Is ``action`` (0-5) at ``speed`` in the ``j``-th new arrangement a test pattern?
+
+    With meaning m = (action mod 3) + 3 · speed (push, pull, slide; slowly, fast)
+    and n new arrangements: test iff (m + j) mod n = 0. Every meaning is held out
+    in exactly one arrangement, on both cube sides (so with the new colour's cube
+    and with the partner's), and every action code once; with 2 partners (n = 4)
+    12 of the 48 new patterns are test, the paper's quarter.
+    """
+    return ((action % 3) + 3 * speed + j) % arrangements == 0
+
+
+def _check_rgba(name: str, rgba: Sequence[float]) -> RGBA:
+    values = tuple(float(v) for v in rgba)
+    if len(values) != 4 or not all(0.0 <= v <= 1.0 for v in values) or values[3] != 1.0:
+        raise ValueError(f"rgba of {name!r} must be 4 numbers in [0, 1] with alpha 1.0 "
+                         f"(an opaque cube), got {tuple(rgba)}; check it with "
+                         "pgae_lite.exercises.check_colour")
+    return values  # type: ignore[return-value]
+
+
+def with_colour(name: str, synonym: str, rgba: Sequence[float],
+                partners: Sequence[str] = DEFAULT_PARTNERS,
+                world: World = DEFAULT_WORLD) -> World:
+    """``world`` with one more cube colour: word and synonym, RGBA, new patterns.
+
+    ``partners``: colours of ``world`` that the new cube shares the table with; each
+    gives the arrangements (name, partner) and (partner, name), 24 new patterns.
+    """
+    lexicon = world.lexicon.with_colour(name, synonym)   # LanguageError: a word taken
+    values = _check_rgba(name, rgba)
+    partners = tuple(partners)
+    unknown = [p for p in partners if p not in world.lexicon.colours]
+    if not partners or unknown or len(set(partners)) < len(partners):
+        raise LanguageError("partners must be distinct colours of the world, at least "
+                            f"one; got {partners}; the colours are: "
+                            f"{', '.join(world.lexicon.colours)}")
+    added = tuple(a for p in partners for a in ((name, p), (p, name)))
+    start = len(world.arrangements)
+    bigger = World(lexicon, world.arrangements + added, world.test_patterns,
+                   world.palette + ((name, values),))
+    test = {bigger.pattern_number(s, start + j, a) for j in range(len(added))
+            for s in (0, 1) for a in range(6) if held_out(j, a, s, len(added))}
+    return World(lexicon, bigger.arrangements, world.test_patterns | frozenset(test),
+                 bigger.palette)
+
+
+__all__ = ["World", "WorldPattern", "DEFAULT_WORLD", "with_colour", "held_out",
+           "EXTENSION_NUMBERING", "DEFAULT_PARTNERS", "PAPER_PATTERNS"]
