@@ -31,6 +31,7 @@ import torch
 from harness import Benchmark, key_value, side_by_side
 from pgae_lite.robot.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
+from pgae_lite.runs.trainings import by_name
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.evaluate import evaluate
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
@@ -49,7 +50,7 @@ def measure(training: str, seed: int, profile: str, threads: int | None, limit: 
     if threads:
         torch.set_num_threads(threads)
     cae, data = cae_and_data(profile)
-    trained = trained_pgae(training, profile, seed, device="cpu", progress=False, **overrides)
+    trained = trained_pgae(by_name(training), profile, seed, device="cpu", progress=False, **overrides)
     t0 = time.perf_counter()
     table = compare(trained.model, cae, trained.normaliser, data, limit=limit,
                     config=get_profile(profile).data, tracking=tracking)

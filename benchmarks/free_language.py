@@ -55,7 +55,8 @@ import torch
 
 from harness import Benchmark, side_by_side
 from pgae_lite.robot.closedloop import variation_of
-from pgae_lite.config import TRAININGS, get_profile, training_profile
+from pgae_lite.config import get_profile, training_profile
+from pgae_lite.runs.trainings import by_name
 from pgae_lite.evaluate import evaluate, predict
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
 from pgae_lite.world.words import SIGNALS, VOCABULARY
@@ -75,7 +76,7 @@ def words(text: str) -> set[str]:
 def training_words(training: str) -> set[str]:
     """Every word of the model's training language: signals, descriptions (and phrasings)."""
     seen = set().union(*(words(s) for s in SIGNALS), *(words(w) for w in VOCABULARY))
-    train = TRAININGS[training].train
+    train = by_name(training).train
     if train.get("phrasings"):
         seen |= training_lexicon(train.get("phrasing_words", "all")).words()
     return seen
@@ -85,7 +86,7 @@ def original_run(training: str, seed: int, profile_name: str, path: str) -> dict
     """One training's canonical Table 1 on the authors' data (resumable under benchmarks/out/)."""
     torch.set_num_threads(1)
     data = load_original(path)
-    profile = training_profile(get_profile(profile_name, seed=seed), training)
+    profile = training_profile(get_profile(profile_name, seed=seed), by_name(training))
     out = Path("benchmarks/out") / f"free_language-original-{profile_name}-{training}-s{seed}"
     trained = train(data, profile, out_dir=out, progress=False)
     cells, _ = evaluate(trained.model, data, trained.normaliser)
@@ -111,7 +112,7 @@ def training_time(bench: Benchmark, args) -> None:
     for seed in args.seeds:
         # the variant first: if the machine's load falls during the run, it favours PGAE-BERT
         for training in ("PGAE-BERT-phrasings", "PGAE-BERT"):
-            profile = training_profile(get_profile(args.profile, seed=seed), training)
+            profile = training_profile(get_profile(args.profile, seed=seed), by_name(training))
             with tempfile.TemporaryDirectory() as empty:
                 os.environ[CACHE_ENV] = empty     # nothing cached: the encoding is timed too
                 t0 = time.perf_counter()
@@ -135,7 +136,7 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
     texts = [input_text("repeat language", t.text) for t in told]   # the readback's inputs
     seen = training_words(training)
     unseen = np.array([bool(words(t.text) - seen) for t in told])
-    trained = trained_pgae(training, profile, seed, device="cpu", progress=False)
+    trained = trained_pgae(by_name(training), profile, seed, device="cpu", progress=False)
     model, norm = trained.model, trained.normaliser
     cells, _ = evaluate(model, data, norm)
     t0 = time.perf_counter()

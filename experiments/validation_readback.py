@@ -32,7 +32,8 @@ from pgae_lite.world.words import LanguageError, parse_description
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.bert.phrase_lexicon import held_out_words, words_of
 from pgae_lite.bert.phrasings import phrasings
-from pgae_lite.config import TRAININGS, TrainConfig, get_profile
+from pgae_lite.config import TrainConfig, get_profile
+from pgae_lite.runs.trainings import by_name
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases
 from pgae_lite.bert.paraphrases import Paraphrase
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
@@ -73,10 +74,10 @@ models = {}                # spec -> (training, seed, options), each checked bef
 for spec in args.models:
     training, seed, *options = spec.split(":")
     models[spec] = training, int(seed), dict(option.split("=") for option in options)
-    fixed = sorted(set(models[spec][2]) & set(TRAININGS[training].train))   # the training would overwrite them
+    fixed = sorted(set(models[spec][2]) & set(by_name(training).train))   # the training would overwrite them
     if fixed:
         parser.error(f"{spec}: {', '.join(fixed)} is set by the training {training} itself "
-                     f"({TRAININGS[training].train}); change it in pgae_lite.config.TRAININGS instead")
+                     f"({by_name(training).train}); change it in pgae_lite.runs.trainings instead")
 torch.set_num_threads(1)
 
 data = simulated_dataset("book", progress=False)
@@ -96,7 +97,7 @@ for i, number in enumerate(test.pattern):
 unseen = np.array(unseen)
 
 for spec, (training, seed, options) in models.items():
-    trained = trained_pgae(training, "book", seed, device="cpu", progress=False,
+    trained = trained_pgae(by_name(training), "book", seed, device="cpu", progress=False,
                            **{k: option_value(k, v) for k, v in options.items()})
     if args.no_lookup and hasattr(trained.model.language_encoder, "word_lookup"):
         trained.model.language_encoder.word_lookup = None

@@ -54,7 +54,7 @@ def test_a_profile_holds_the_whole_run():
 def test_to_dict_holds_only_the_models_recipe():
     """It is hashed into the cache keys of trained models and saved in checkpoints: nothing else goes in."""
     for name in PROFILE_NAMES:
-        assert set(get_profile(name).to_dict()) == {"name", "model", "train"}
+        assert set(get_profile(name).to_dict()) == {"name", "recipe_version", "model", "train"}
 
 
 def test_get_profile_copies():
@@ -66,11 +66,15 @@ def test_get_profile_copies():
 def test_recipes_live_here():
     import pgae_lite.runs.reproduce
     from pgae_lite.config import ROWS, TRAININGS, training_profile
+    from pgae_lite.runs.trainings import NO_PLAN, PHRASINGS, SIDE_TRAININGS
 
-    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-no-plan", "PGAE-views", "PGAE-BERT-phrasings",
-                              "PGAE-BERT-phrasings-held-out"]
-    assert training_profile(get_profile("book"), "PGAE-no-plan").model.plan_keyframes == 0
-    assert {training for training, _ in ROWS.values()} <= set(TRAININGS)
+    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-views"]          # Table 1's, and no other
+    assert not set(SIDE_TRAININGS) & set(TRAININGS)
+    assert training_profile(get_profile("book"), NO_PLAN).model.plan_keyframes == 0
+    assert training_profile(get_profile("book"), PHRASINGS).train.phrasings == 60
+    with pytest.raises(ValueError, match="unknown training 'PGAE-no-plan'; Table 1's trainings are"):
+        training_profile(get_profile("book"), "PGAE-no-plan")
+    assert {training for training, _ in ROWS.values()} == set(TRAININGS)
     assert pgae_lite.runs.reproduce.TRAININGS is TRAININGS and pgae_lite.runs.reproduce.ROWS is ROWS
     smoke = get_profile("smoke")
     bert = training_profile(smoke, "PGAE-BERT", pretrained_model="bert-base-uncased")
@@ -86,7 +90,19 @@ def test_gmu_norm_is_the_book_recipe_and_not_the_papers():
     assert ModelConfig().gmu_norm and get_profile("book").model.gmu_norm
     assert not get_profile("paper").model.gmu_norm
     assert PGAE(ModelConfig(units=8)).gmu.normalise_action
-    # a checkpoint saved before the setting existed was trained without it
-    old = {k: v for k, v in ModelConfig(units=8).__dict__.items() if k != "gmu_norm"}
-    assert not ModelConfig.from_checkpoint(old).gmu_norm
-    assert ModelConfig.from_checkpoint({**old, "gmu_norm": True}).gmu_norm
+
+
+
+def test_a_checkpoint_of_another_recipe_version_is_refused():
+    """One recipe version replaces the guesses of what an older checkpoint was trained with."""
+    from pgae_lite.train.config import RECIPE_VERSION, saved_model_config
+    from pgae_lite.util.storage import CheckpointMismatchError
+
+    recipe = get_profile("smoke").to_dict()
+    assert saved_model_config(recipe, "x.pt") == get_profile("smoke").model
+    old = {k: v for k, v in recipe.items() if k != "recipe_version"}          # saved before versions
+    with pytest.raises(CheckpointMismatchError, match="x.pt was trained with recipe version before versions; "
+                                                      f"this pgae_lite reads version {RECIPE_VERSION}"):
+        saved_model_config(old, "x.pt")
+    with pytest.raises(CheckpointMismatchError, match="recipe version 1;"):
+        saved_model_config({**recipe, "recipe_version": 1}, "x.pt")

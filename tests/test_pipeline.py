@@ -47,11 +47,14 @@ def test_several_models_train_side_by_side_and_then_load():
     from pgae_lite.config import training_profile
     from pgae_lite.runs.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
 
-    for training in ("PGAE", "PGAE-no-plan"):     # left by an earlier run of this test in the same cache
-        shutil.rmtree(_model_folder(training_profile(get_profile("smoke", seed=7), training), training),
+    from pgae_lite.config import TRAININGS
+    from pgae_lite.runs.trainings import NO_PLAN
+
+    for training in (TRAININGS["PGAE"], NO_PLAN):     # left by an earlier run of this test in the same cache
+        shutil.rmtree(_model_folder(training_profile(get_profile("smoke", seed=7), training), training.name),
                       ignore_errors=True)
-        assert not _finished(training, "smoke", 7)
-    models = trained_pgaes(["PGAE", "PGAE-no-plan"], "smoke", seed=7, device="cpu", progress=False, workers=2)
+        assert not _finished(training, get_profile("smoke"), 7)
+    models = trained_pgaes(["PGAE", NO_PLAN], "smoke", seed=7, device="cpu", progress=False, workers=2)
     assert set(models) == {"PGAE", "PGAE-no-plan"}
     assert models["PGAE"].model.plan_head is not None and models["PGAE-no-plan"].model.plan_head is None
     again = trained_pgae("PGAE", "smoke", 7, device="cpu", progress=False)      # from the cache
@@ -90,7 +93,9 @@ def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(mo
     from pgae_lite.config import training_profile
     from pgae_lite.util.storage import config_digest
 
-    prof = training_profile(get_profile("smoke"), "PGAE-BERT-phrasings")
+    from pgae_lite.runs.trainings import PHRASINGS
+
+    prof = training_profile(get_profile("smoke"), PHRASINGS)
     before = pipeline._model_folder(prof, "PGAE-BERT-phrasings")
     assert pipeline._model_folder(prof, "PGAE-BERT-phrasings") == before        # the same sentences, the same model
     shorter = replace(phrase_lexicon.LEXICON, carriers=phrase_lexicon.LEXICON.carriers[:-1])

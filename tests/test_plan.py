@@ -40,12 +40,10 @@ def test_loss_counts_only_signals_that_execute_a_motion():
     assert EXECUTE in PLAN_SIGNALS and DESCRIBE not in PLAN_SIGNALS
 
 
-def test_paper_profile_has_no_plan_head_and_old_checkpoints_load_without_one():
+def test_paper_profile_has_no_plan_head():
     assert PGAE(PROFILES["paper"].model).plan_head is None
     assert PROFILES["paper"].train.plan_weight == 0
     assert PGAE(PROFILES["book"].model).plan_head is not None
-    saved = {k: v for k, v in vars(ModelConfig()).items() if k != "plan_keyframes"}
-    assert ModelConfig.from_checkpoint(saved).plan_keyframes == 0     # a checkpoint from before the head
 
 
 @pytest.mark.parametrize("bad", [-1, 2.5, True, "10"])

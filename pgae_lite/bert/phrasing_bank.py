@@ -29,7 +29,6 @@ from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
 from pgae_lite.bert.phrase_lexicon import PhraseLexicon
 from pgae_lite.bert.phrasings import phrasings
 from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder, cached_token_vectors
-from pgae_lite.config import TrainConfig
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, input_text
 from pgae_lite.model.signals import LANG_IN, SignalBatch
 from pgae_lite.bert.tuned_layer import TRAIN_EVERY
@@ -44,7 +43,7 @@ class PhrasingBank:
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
                  lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
-                 prob: float = TrainConfig.phrasing_prob):
+                 prob: float = 0.75):
         if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "

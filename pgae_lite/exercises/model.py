@@ -19,7 +19,7 @@ from typing import Callable, Sequence
 import torch
 from torch import nn
 
-from pgae_lite.config import ModelConfig
+from pgae_lite.model.config import ModelConfig
 from pgae_lite.data.dataset import Normaliser
 from pgae_lite.world.words import SIGNALS, word_weights
 from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell

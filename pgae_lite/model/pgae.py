@@ -24,7 +24,7 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from pgae_lite.config import ModelConfig
+from pgae_lite.model.config import LANGUAGE_ENCODERS, ModelConfig
 from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
 from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, Lexicon
 from pgae_lite.model.layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
@@ -73,9 +73,6 @@ class LanguageEncoder(nn.Module):
         x = nn.functional.one_hot(tokens, self.input_dim).float()   # (B, 5, 28)
         _, state = self.rnn(x, lengths)
         return state_to_vector(state)                           # (B, 400)
-
-
-LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
 
 
 def make_language_encoder(cfg: ModelConfig,

@@ -28,7 +28,8 @@ import numpy as np
 import torch
 
 from pgae_lite.cae import ChannelSeparatedCAE, extract_features
-from pgae_lite.config import ModelConfig, get_profile, profile_name
+from pgae_lite.config import Profile, get_profile
+from pgae_lite.train.config import saved_model_config
 from pgae_lite.data.dataset import PGAEDataset, from_recordings
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs.pipeline import cached_cae, cached_dataset
@@ -42,38 +43,41 @@ if TYPE_CHECKING:
     from pgae_lite.train.loop import Trained
 
 
-def new_recordings(world: World, profile: str | None = None) -> DatasetConfig:
-    """What :func:`record` records: the world's new patterns, as the profile's data."""
+def new_recordings(world: World, profile: Profile | str | None = None) -> DatasetConfig:
+    """What :func:`record` records: the world's new patterns, as the profile's data.
+
+    ``profile`` here and below: a :class:`~pgae_lite.config.Profile`, or a name resolved once
+    by the function called (``None``: the default profile).
+    """
     if not world.new_patterns:
         raise ValueError("this world has no patterns beyond the paper's 144; extend it "
                          "first: world = with_colour(name, synonym, rgba)")
     return replace(get_profile(profile).data, patterns=world.new_patterns, world=world)
 
 
-def record(world: World, profile: str | None = None, workers: int | None = None,
+def record(world: World, profile: Profile | str | None = None, workers: int | None = None,
            progress: bool = True) -> GenerationReport:
     """Record the world's new episodes (cached: only what is missing is recorded)."""
     return generate(new_recordings(world, profile), workers=workers, progress=progress)
 
 
-def _stem(world: World, profile: str | None) -> str:
+def _stem(world: World, prof: Profile) -> str:
     """Cache name: the old data's key, the new data's key, the CAE's config digest."""
-    prof = get_profile(profile)
-    new = new_recordings(world, profile)
+    new = new_recordings(world, prof)
     return f"{prof.data.key()}+{new.key()}-{config_digest(prof.cae.to_dict())}"
 
 
-def cae_path(world: World, profile: str | None = None) -> Path:
+def cae_path(world: World, profile: Profile | str | None = None) -> Path:
     """Where the CAE of the old and the new recordings is cached."""
-    return cache_dir() / "cae" / f"{_stem(world, profile)}.pt"
+    return cache_dir() / "cae" / f"{_stem(world, get_profile(profile))}.pt"
 
 
-def trained_cae(world: World, profile: str | None = None, device: str | None = None,
+def trained_cae(world: World, profile: Profile | str | None = None, device: str | None = None,
                 progress: bool = True, workers: int | None = None
                 ) -> tuple[ChannelSeparatedCAE, list[dict]]:
     """A CAE (the profile's recipe) trained on old and new training episodes' frames."""
     prof = get_profile(profile)
-    old, new = prof.data, new_recordings(world, profile)
+    old, new = prof.data, new_recordings(world, prof)
     generate(old, workers=workers, progress=progress)
     generate(new, workers=workers, progress=progress)
     stride = prof.cae.frame_stride
@@ -81,18 +85,18 @@ def trained_cae(world: World, profile: str | None = None, device: str | None = N
     def frames() -> np.ndarray:                                  # (N, 120, 160, 3)
         return np.concatenate([training_frames(old, stride),
                                training_frames(new, stride)])
-    return cached_cae(cae_path(world, profile), prof.cae, frames, device, progress)
+    return cached_cae(cae_path(world, prof), prof.cae, frames, device, progress)
 
 
-def extended_dataset(world: World, profile: str | None = None,
+def extended_dataset(world: World, profile: Profile | str | None = None,
                      device: str | None = None, progress: bool = True,
                      workers: int | None = None) -> PGAEDataset:
     """Old and new episodes, the new CAE's features (cached), in the world's words."""
     prof = get_profile(profile)
-    new = new_recordings(world, profile)
+    new = new_recordings(world, prof)
 
     def make() -> PGAEDataset:
-        model, _ = trained_cae(world, profile, device, progress, workers)
+        model, _ = trained_cae(world, prof, device, progress, workers)
 
         def features(frames: np.ndarray) -> np.ndarray:    # (T, 120, 160, 3) -> (T, 30)
             return extract_features(model, frames)
@@ -102,34 +106,33 @@ def extended_dataset(world: World, profile: str | None = None,
               f"sim/{episode_name(ep.pattern, ep.variation)}",
               ep.joints, features(ep.images), features(ep.images_opposite))
              for ep in episodes), source=f"simulated:{prof.data.key()}+{new.key()}")
-    path = cache_dir() / "features" / f"{_stem(world, profile)}.npz"
+    path = cache_dir() / "features" / f"{_stem(world, prof)}.npz"
     return cached_dataset(path, make)
 
 
-def pgae_folder(world: World, profile: str | None = None, seed: int = 0,
+def pgae_folder(world: World, profile: Profile | str | None = None, seed: int = 0,
                 **train_overrides) -> Path:
-    """Where :func:`trained_pgae` keeps its checkpoint."""
+    """Where :func:`trained_pgae` keeps its checkpoint (the recipe's digest holds its version)."""
     prof = get_profile(profile, seed=seed, **train_overrides)
     recipe = config_digest(prof.to_dict())
-    return cache_dir() / "pgae" / f"{_stem(world, profile)}-PGAE-{recipe}"
+    return cache_dir() / "pgae" / f"{_stem(world, prof)}-PGAE-{recipe}"
 
 
-def trained_pgae(world: World, profile: str | None = None, seed: int = 0,
+def trained_pgae(world: World, profile: Profile | str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True,
                  **train_overrides) -> Trained:
     """PGAE built for the world's lexicon, trained (the profile's recipe) on
     :func:`extended_dataset`; cached, and resumed after an interruption."""
     from pgae_lite.train.loop import train
 
-    name = profile_name(profile)
-    prof = get_profile(name, seed=seed, **train_overrides)
+    prof = get_profile(profile, seed=seed, **train_overrides)     # a name is resolved once, here
     if prof.model.language_encoder != "lstm":
         raise ValueError("a new colour needs PGAE's own language encoder "
                          "(language_encoder='lstm'); PGAE-BERT reads the paper's words")
-    dataset = extended_dataset(world, name, device, progress)
+    dataset = extended_dataset(world, prof, device, progress)
     torch.manual_seed(prof.train.seed)      # the same initialisation every run
     model = PGAE(prof.model, world.lexicon)
-    folder = pgae_folder(world, name, seed, **train_overrides)
+    folder = pgae_folder(world, prof)
     return train(dataset, prof, out_dir=folder, device=device, progress=progress,
                  model=model)
 
@@ -142,7 +145,7 @@ def load_pgae(path: str | Path, world: World, device: str | None = None
 
     path = Path(path)
     ckpt = load_checkpoint(path / CHECKPOINT if path.is_dir() else path)
-    model = PGAE(ModelConfig.from_checkpoint(ckpt["profile"]["model"]), world.lexicon)
+    model = PGAE(saved_model_config(ckpt["profile"], path), world.lexicon)
     try:
         model.load_state_dict(ckpt["model"])
     except RuntimeError as e:                     # the first mismatch, e.g. the words

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Callable
 import numpy as np
 
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
-from pgae_lite.config import TRAININGS, get_profile, profile_name, training_profile
+from pgae_lite.config import Profile, Training, as_training, get_profile, training_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.bert.phrase_lexicon import training_lexicon
 from pgae_lite.bert.phrasings import phrasings_digest
@@ -49,10 +49,14 @@ def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
     return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
 
 
-def trained_cae(profile: str | None = None, device: str | None = None, progress: bool = True,
+def trained_cae(profile: Profile | str | None = None, device: str | None = None, progress: bool = True,
                 workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
-    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
-    prof = get_profile(profile)                  # None: the default profile (config.profile_name)
+    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history.
+
+    ``profile``: a :class:`~pgae_lite.config.Profile`, or a name resolved once here
+    (``None``: the default profile, :func:`pgae_lite.config.profile_name`).
+    """
+    prof = get_profile(profile)
     data, cae = prof.data, prof.cae
     generate(data, workers=workers, progress=progress)
     return cached_cae(cae_path(data, cae), cae,
@@ -75,15 +79,15 @@ def cached_cae(path: Path, cae: CAEConfig, frames: Callable[[], np.ndarray],
     return train_cae(frames(), cae, device, progress, out_path=path)
 
 
-def simulated_dataset(profile: str | None = None, device: str | None = None, progress: bool = True,
+def simulated_dataset(profile: Profile | str | None = None, device: str | None = None, progress: bool = True,
                       workers: int | None = None) -> PGAEDataset:
     """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
-    prof = get_profile(profile)
+    prof = get_profile(profile)                  # a name is resolved once, here
     data, cae_config = prof.data, prof.cae
     path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
 
     def make() -> PGAEDataset:
-        model, _ = trained_cae(prof.name, device, progress, workers)
+        model, _ = trained_cae(prof, device, progress, workers)
         return to_dataset(data, lambda frames: extract_features(model, frames),
                           progress)
     return cached_dataset(path, make)
@@ -102,24 +106,25 @@ def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
     return dataset
 
 
-def _model_folder(prof, training: str) -> Path:
+def _model_folder(prof: Profile, training: str) -> Path:
     """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
-    (and, for a training on phrasings, the sentences' own)."""
+    (the recipe's holds its version) and, for a training on phrasings, the sentences' own."""
     name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
-    if prof.train.phrasings:   # "-b2": the bank encodes only the signals that read phrasings (other rounding)
+    if prof.train.phrasings:
         name += "-" + phrasings_digest(prof.train.phrasings, prof.train.seed,
-                                       training_lexicon(prof.train.phrasing_words)) + "-b2"
+                                       training_lexicon(prof.train.phrasing_words))
     return cache_dir() / "pgae" / name
 
 
-def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int = 0,
+def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | None = None, seed: int = 0,
                  device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
     """A model of one training (for a row of Table 1) on the profile's simulated data, cached.
 
     Loaded from the cache if it was trained before.
 
-    ``training`` is one of :data:`pgae_lite.config.TRAININGS` (``"PGAE"``,
-    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite);
+    ``training`` is one of :data:`pgae_lite.config.TRAININGS` by name (``"PGAE"``,
+    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite), or any
+    :class:`~pgae_lite.config.Training` value (:mod:`pgae_lite.runs.trainings`);
     ``train_overrides`` change the profile's training options (e.g. ``seed=1``); without
     them it is the profile's recipe, the model every chapter and ``reproduce`` train.
     An interrupted training resumes from its last checkpoint. When another process
@@ -128,12 +133,11 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
     """
     from pgae_lite.train.loop import CHECKPOINT, DataMismatchError, train
 
-    if training not in TRAININGS:
-        raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
-    name = profile_name(profile)
-    dataset = simulated_dataset(name, device, progress)
-    prof = training_profile(get_profile(name, seed=seed, **train_overrides), training)
-    folder = _model_folder(prof, training)
+    training = as_training(training)
+    base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
+    dataset = simulated_dataset(base, device, progress)
+    prof = training_profile(base, training)
+    folder = _model_folder(prof, training.name)
     announced = False
     while True:
         try:
@@ -145,12 +149,12 @@ def trained_pgae(training: str = "PGAE", profile: str | None = None, seed: int =
             (folder / CHECKPOINT).unlink()
         except FolderBusyError:           # another process trains this very model into the cache:
             if progress and not announced:  # wait for it, then load what it trained
-                print(f"{training}: another process is training this model; waiting for it ...", flush=True)
+                print(f"{training.name}: another process is training this model; waiting for it ...", flush=True)
             announced = True
             time.sleep(BUSY_POLL_SECONDS)
 
 
-def _train_alone(training: str, profile: str, seed: int) -> float:
+def _train_alone(training: Training, profile: Profile, seed: int) -> float:
     """A worker of :func:`trained_pgaes`: one training on one thread; its training time (s)."""
     import torch
 
@@ -158,7 +162,8 @@ def _train_alone(training: str, profile: str, seed: int) -> float:
     return trained_pgae(training, profile, seed, device="cpu", progress=False).seconds
 
 
-def trained_pgaes(trainings: list[str], profile: str | None = None, seed: int = 0, device: str | None = None,
+def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None = None, seed: int = 0,
+                  device: str | None = None,
                   progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
     """Several of :func:`trained_pgae`'s models, by training name; those not cached are trained side by side.
 
@@ -172,31 +177,29 @@ def trained_pgaes(trainings: list[str], profile: str | None = None, seed: int = 
     """
     import torch
 
-    for training in trainings:
-        if training not in TRAININGS:
-            raise ValueError(f"unknown training {training!r}; the trainings are: {', '.join(TRAININGS)}")
-    name = profile_name(profile)
+    trainings = [as_training(t) for t in trainings]
+    prof = get_profile(profile)                                     # a name is resolved once, here
     cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
-    todo = [t for t in dict.fromkeys(trainings) if not _finished(t, name, seed)]
+    todo = [t for t in {t.name: t for t in trainings}.values() if not _finished(t, prof, seed)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
-        simulated_dataset(name, device, progress)         # recorded and encoded once, before the workers read it
+        simulated_dataset(prof, device, progress)         # recorded and encoded once, before the workers read it
         if progress:
-            print(f"training {', '.join(todo)} side by side, {workers} at a time, one core each ...", flush=True)
+            print(f"training {', '.join(t.name for t in todo)} side by side, {workers} at a time, one core each ...", flush=True)
         with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            for training, seconds in zip(todo, pool.map(_train_alone, todo, [name] * len(todo),
+            for training, seconds in zip(todo, pool.map(_train_alone, todo, [prof] * len(todo),
                                                         [seed] * len(todo))):
                 if progress:
-                    print(f"{training}: trained in {seconds / 60:.1f} min", flush=True)
-    return {t: trained_pgae(t, name, seed, device, progress) for t in trainings}
+                    print(f"{training.name}: trained in {seconds / 60:.1f} min", flush=True)
+    return {t.name: trained_pgae(t, prof, seed, device, progress) for t in trainings}
 
 
-def _finished(training: str, profile: str, seed: int) -> bool:
+def _finished(training: Training, profile: Profile, seed: int) -> bool:
     """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
     from pgae_lite.train.loop import CHECKPOINT, load_checkpoint
 
     prof = training_profile(get_profile(profile, seed=seed), training)
-    folder = _model_folder(prof, training)
+    folder = _model_folder(prof, training.name)
     try:
         return load_checkpoint(folder / CHECKPOINT)["epoch"] >= prof.train.epochs
     except Exception:  # noqa: BLE001 -- missing or damaged: trained_pgae trains (again)

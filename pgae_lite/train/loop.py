@@ -22,7 +22,8 @@ import torch
 from torch import nn
 from tqdm.auto import tqdm
 
-from pgae_lite.config import ModelConfig, Profile, get_profile
+from pgae_lite.config import Profile, get_profile
+from pgae_lite.train.config import saved_model_config
 from pgae_lite.data.dataset import JOINT_DIM, Normaliser, PGAEDataset
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.world.words import SIGNALS, word_weights
@@ -330,7 +331,7 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         _check_trained_on(ckpt, fitted, path, dataset.source)
-    model = PGAE(ModelConfig.from_checkpoint(ckpt["profile"]["model"]))
+    model = PGAE(saved_model_config(ckpt["profile"], path))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt

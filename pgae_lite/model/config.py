@@ -1,0 +1,74 @@
+"""PGAE's architecture settings, :class:`ModelConfig` (paper Sec. 3; sizes from the authors' code).
+
+The defaults are the ``book`` recipe; the paper's own settings are the ``paper`` profile in
+:mod:`pgae_lite.config`, written as the book recipe with one override per line. Every departure
+is marked ``# Deviation from paper:`` here; what it measured to is on the book's results page
+(appendix A2), not in these comments.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: The language encoders a ModelConfig may name: the paper's LSTM (PGAE), the frozen pretrained
+#: transformer (PGAE-BERT), and the transformer read through a trained attention pooling (not in the paper).
+LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
+
+
+@dataclass
+class ModelConfig:
+    """Architecture of PGAE (:class:`pgae_lite.model.pgae.PGAE`). Defaults are the ``book`` recipe.
+
+    Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50.
+    """
+
+    units: int = 100
+    layers: int = 2
+    hidden: int = 50
+    cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
+    # Deviation from paper: "start" = the action decoder reads the start joints at every step instead of
+    # its own previous prediction ("predicted", the paper's; see pgae.ActionDecoder).
+    joint_feedback: str = "start"
+    # Deviation from paper: one step of the action LSTMs covers 3 time steps: the encoder reads every 3rd
+    # step, the decoder reads every 3rd frame and writes the next 3 poses, every pose (paper: 1). A third of
+    # the LSTM steps per sample, with Table 1 kept; stride 4 lost joint precision (A2, the recipe's history).
+    time_stride: int = 3
+    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (bert/pretrained.py);
+    # "pretrained-attention" = the same transformer with a trained attention pooling (bert/attention_pooling.py).
+    language_encoder: str = "lstm"
+    pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
+    # Not in the paper (which keeps the transformer frozen): with "pretrained-attention", free text reads
+    # the transformer's top layer trained (bert/tuned_layer.py); the 869 fixed inputs stay frozen.
+    tuned_top_layer: bool = False
+    # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
+    # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
+    # every sample early in training, and describe never learns: one sentence for every action
+    # (A2, "The describe collapse").
+    gmu_norm: bool = True
+    # Deviation from paper: a plan head reads h and predicts this many keyframes of the motion in training
+    # (plan.PlanHead; 0 = none, the paper's). It makes h carry which cube the words mean in this scene, which
+    # the recorded frames otherwise tell the decoder: without it the closed loop mostly moves the other cube.
+    plan_keyframes: int = 10
+
+    def __post_init__(self):
+        if isinstance(self.plan_keyframes, bool) or not isinstance(self.plan_keyframes, int) \
+                or self.plan_keyframes < 0:
+            raise ValueError(f"plan_keyframes must be a whole number >= 0 (0 = no plan head, the paper's); "
+                             f"got {self.plan_keyframes!r}")
+        if self.language_encoder not in LANGUAGE_ENCODERS:
+            raise ValueError(f"unknown language_encoder {self.language_encoder!r}; "
+                             f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
+        if not isinstance(self.tuned_top_layer, bool):
+            raise ValueError(f"tuned_top_layer must be True or False; got {self.tuned_top_layer!r}")
+        if self.tuned_top_layer and self.language_encoder != "pretrained-attention":
+            raise ValueError(f"tuned_top_layer needs language_encoder='pretrained-attention' (the free-form "
+                             f"variant's encoder); got language_encoder={self.language_encoder!r}")
+        if not isinstance(self.time_stride, int) or self.time_stride < 1:
+            raise ValueError(f"time_stride must be a whole number >= 1 (1 = every step, the paper's); "
+                             f"got {self.time_stride!r}")
+
+    @property
+    def state_dim(self) -> int:
+        return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
+
+
+__all__ = ["LANGUAGE_ENCODERS", "ModelConfig"]
