@@ -1,4 +1,4 @@
-"""The package's import graph: nothing imports in a circle, and one module owns the profiles.
+"""The package's import graph: its layers, no circles, and one module owns the profiles.
 
 Every module of ``pgae_lite`` is parsed (not imported) and every import of another
 module of the package is an edge, whether it sits at the top of the file, inside a
@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import ast
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 PACKAGE = Path(__file__).resolve().parent.parent / "pgae_lite"
@@ -88,12 +90,41 @@ def reachable(name: str) -> set[str]:
     return seen
 
 
+def unit(name: str) -> str:
+    """The top-level entry of the package that module ``name`` belongs to: a folder or a module."""
+    parts = name.split(".")
+    return parts[1] if len(parts) > 1 else "pgae_lite"
+
+
+#: Each folder (or top-level module) and the folders it may import: the package's layers, lowest first.
+#: The model imports only the world, the dataset type and the utilities; the pretrained encoders (bert)
+#: build on the model; training on both; config composes each part's settings; runs and robot are on top.
+LAYERS = {
+    "util": set(),
+    "world": {"util"},
+    "sim": {"world", "util"},
+    "data": {"sim", "world", "util"},
+    "cae": {"util"},
+    "model": {"data", "world", "util"},
+    "bert": {"model", "data", "world", "util"},
+    "evaluate": {"model", "data", "world", "util"},
+    "viz": {"model", "data", "world", "util"},
+    "train": {"bert", "model", "data", "world", "util"},
+    "config": {"train", "model", "cae", "data", "world", "util"},
+    "exercises": {"train", "evaluate", "model", "data", "sim", "world", "util"},
+    "runs": {"config", "train", "evaluate", "bert", "model", "cae", "data", "sim", "world", "util"},
+    "robot": {"runs", "config", "evaluate", "bert", "model", "cae", "data", "sim", "viz", "world", "util"},
+    "__main__": {"runs", "config", "data", "util"},
+    "pgae_lite": set(),
+}
+
+
 def test_the_graph_is_read():
-    assert GRAPH["pgae_lite.train.loop"] >= {"pgae_lite.config", "pgae_lite.model.pgae", "pgae_lite.util.storage"}
+    assert GRAPH["pgae_lite.train.loop"] >= {"pgae_lite.model.pgae", "pgae_lite.util.storage"}
     assert "pgae_lite.train.loop" in GRAPH["pgae_lite.runs.pipeline"]           # a function-level import counts
-    assert "pgae_lite.world.words" in GRAPH["pgae_lite.sim.actions"]      # from ..language
-    assert "pgae_lite.sim" in GRAPH["pgae_lite.robot.closedloop"]            # a subpackage runs its __init__
-    assert "pgae_lite.world.patterns" in GRAPH["pgae_lite.robot.playground"]       # from . import patterns
+    assert "pgae_lite.world.words" in GRAPH["pgae_lite.sim.actions"]
+    assert "pgae_lite.sim" in GRAPH["pgae_lite.robot.closedloop"]             # a subpackage runs its __init__
+    assert "pgae_lite.world.patterns" in GRAPH["pgae_lite.robot.playground"]   # from pgae_lite.world import patterns
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
 
 
@@ -102,37 +133,36 @@ def test_no_import_cycles():
     assert cycle is None, "modules import each other in a circle: " + " -> ".join(cycle)
 
 
-def test_config_imports_nothing_that_imports_it():
-    below = reachable("pgae_lite.config")
-    assert not below & {"pgae_lite.config", "pgae_lite.train.loop", "pgae_lite.runs.pipeline", "pgae_lite.runs.reproduce",
-                        "pgae_lite.model.pgae"}, sorted(below)
-    # plumbing: imports nothing of ours but the errors (which import nothing)
+def test_every_entry_of_the_package_has_a_layer():
+    assert {unit(name) for name in MODULES} == set(LAYERS)
+    assert find_cycle({u: set(allowed) for u, allowed in LAYERS.items()}) is None
+
+
+def test_each_folder_imports_only_the_folders_below_it():
+    wrong = sorted(f"{name} imports {target}" for name, targets in GRAPH.items() for target in targets
+                   if unit(target) != unit(name) and unit(target) not in LAYERS[unit(name)])
+    assert not wrong, "imports against the layers of LAYERS:\n" + "\n".join(wrong)
+
+
+def test_the_model_imports_no_simulator_cae_or_transformer():
+    """A student on the authors' data or the toy data imports PGAE without pybullet or transformers."""
+    code = ("import sys; import pgae_lite.model.pgae, pgae_lite.model.config, pgae_lite.data.dataset, "
+            "pgae_lite.data.toy, pgae_lite.evaluate; print(' '.join(sorted(sys.modules)))")
+    loaded = set(subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
+                                cwd=PACKAGE.parent).stdout.split())
+    assert "pgae_lite.model.pgae" in loaded                       # the check can see what was imported
+    unwanted = {m for m in loaded if m.split(".")[0] in ("pybullet", "transformers", "pybullet_data")
+                or m.startswith(("pgae_lite.sim", "pgae_lite.bert", "pgae_lite.runs", "pgae_lite.robot"))
+                or m in ("pgae_lite.cae", "pgae_lite.config", "pgae_lite.data.simulated")}
+    assert not unwanted, sorted(unwanted)
+
+
+def test_plumbing_imports_nothing_above_it():
     assert reachable("pgae_lite.util.storage") == {"pgae_lite.util.errors"}
     assert not reachable("pgae_lite.util.errors")
-    assert "pgae_lite.train.loop" not in reachable("pgae_lite.cae")
-    assert "pgae_lite.runs.reproduce" not in reachable("pgae_lite.runs.pipeline")
-
-
-#: What the rest of the package builds on: none of these may import a module above it.
-HIGH = {"pgae_lite.train.loop", "pgae_lite.evaluate", "pgae_lite.runs.pipeline", "pgae_lite.runs.reproduce", "pgae_lite.robot.closedloop",
-        "pgae_lite.robot.instructions", "pgae_lite.robot.playground", "pgae_lite.viz", "pgae_lite.exercises"}
-
-
-def test_no_backwards_imports():
-    """Low-level modules never import high-level ones (a split module must not reach back up)."""
-    # the numbering needs only the words (and the words their error's base class)
     assert reachable("pgae_lite.world.patterns") == {"pgae_lite.world.words", "pgae_lite.util.errors", "pgae_lite.util"}
-    assert reachable("pgae_lite.data.dataset") <= {"pgae_lite.world.words", "pgae_lite.world.patterns", "pgae_lite.world",
-                                                   "pgae_lite.util.storage", "pgae_lite.util.errors", "pgae_lite.util"}
-    for name in ("pgae_lite.sim.record", "pgae_lite.sim"):
-        assert "pgae_lite.data.dataset" not in reachable(name), name                  # the simulator needs the patterns only
-    low = [n for n in MODULES if n.startswith("pgae_lite.sim") or n in (
-        "pgae_lite.world.words", "pgae_lite.world.patterns", "pgae_lite.data.dataset", "pgae_lite.data.original", "pgae_lite.model.layers",
-        "pgae_lite.model.signals", "pgae_lite.cae", "pgae_lite.data.simulated", "pgae_lite.config", "pgae_lite.model.pgae")]
-    for name in low:
-        assert not {h for h in reachable(name) for top in HIGH if h == top or h.startswith(top + ".")}, name
+    assert "pgae_lite.runs.reproduce" not in reachable("pgae_lite.runs.pipeline")
     assert "pgae_lite.robot.instructions" not in reachable("pgae_lite.robot.closedloop")
-    assert not reachable("pgae_lite.viz") & {"pgae_lite.train.loop", "pgae_lite.evaluate", "pgae_lite.robot.closedloop"}
 
 
 def test_every_module_is_at_most_350_lines():

@@ -1,4 +1,5 @@
-"""Training PGAE (paper Sec. 4): its settings, its loss, its loop and its checkpoints.
+"""Training PGAE (paper Sec. 3, "Loss Function", and Sec. 4, "Training Details").
 
-- ``loop``   loss, the training loop, checkpoints, ``load_model``
+- ``config``  ``TrainConfig``, the training's settings, and the recipe version saved with every checkpoint
+- ``loop``    loss, the training loop, checkpoints, ``load_model``
 """
