@@ -99,8 +99,8 @@ def main(argv: list[str] | None = None) -> int:
 def run_command(args: argparse.Namespace) -> int:
     """Check the parsed arguments (before any data is read), then run the command."""
     from pgae_lite.config import profile_name
-    from pgae_lite.util.errors import ArgumentError
     from pgae_lite.util.checks import whole_number
+    from pgae_lite.util.errors import ArgumentError
 
     try:                      # --profile is checked by argparse; this checks the environment variable too
         profile = profile_name(args.profile)

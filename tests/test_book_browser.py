@@ -75,7 +75,7 @@ if (_why := _missing_browser()) is not None:
         raise RuntimeError(_why)
     pytest.skip(_why, allow_module_level=True)
 
-from playwright.sync_api import sync_playwright
+from playwright.sync_api import sync_playwright  # noqa: E402 -- only once the browser is known to be there
 
 
 def toc_pages() -> list[str]:

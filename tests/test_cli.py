@@ -171,8 +171,8 @@ def test_unknown_row_and_bad_seed_count_are_clear_errors(capsys):
 
 
 def test_cli_profile_names_match_the_package():
-    from pgae_lite.__main__ import PROFILE_ENV, PROFILE_NAMES, ROW_NAMES
     import pgae_lite.config as config
+    from pgae_lite.__main__ import PROFILE_ENV, PROFILE_NAMES, ROW_NAMES
     from pgae_lite.config import PROFILES, ROWS
 
     assert tuple(PROFILES) == PROFILE_NAMES == config.PROFILE_NAMES

@@ -7,12 +7,12 @@ import numpy as np
 import pytest
 import torch
 
+from pgae_lite.config import ModelConfig
 from pgae_lite.data.dataset import Normaliser
 from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
-from pgae_lite.world.words import TEST_SIGNALS, WORD_INDEX
-from pgae_lite.world.patterns import Pattern
-from pgae_lite.config import ModelConfig
 from pgae_lite.model.pgae import PGAE
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import TEST_SIGNALS, WORD_INDEX
 
 
 def _predictions(lengths, error, T=100):

@@ -13,8 +13,16 @@ import pytest
 import torch
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu,
-                                 check_lstm_step, check_peephole_step, check_signal_probs)
+
+from pgae_lite.exercises import (
+    CheckResult,
+    check_bottleneck,
+    check_colour,
+    check_gmu,
+    check_lstm_step,
+    check_peephole_step,
+    check_signal_probs,
+)
 from pgae_lite.model.layers import GatedMultimodalUnit
 
 ORANGE = (0.98, 0.5, 0.05, 1.0)
@@ -68,7 +76,7 @@ class StubBottleneck(GatedMultimodalUnit):
 
 @pytest.mark.parametrize("factory, phrases", [
     (StubBottleneck, ["your module returned None; expected the pair (h, z)", "(4, 6)"]),
-    (lambda a, l, h: None, ["factory(12, 9, 6) returned None", "nn.Module"]),
+    (lambda action, language, hidden: None, ["factory(12, 9, 6) returned None", "nn.Module"]),
 ])
 def test_bottleneck_stub_returning_none_fails(factory, phrases):
     result = check_bottleneck(factory)

@@ -27,19 +27,23 @@ from test_original import SUBTREES, _fake_tree
 from test_train import tiny_profile
 
 import pgae_lite
-from pgae_lite.runs import pipeline
 from pgae_lite.cae import load_cae
 from pgae_lite.config import TrainConfig, get_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
-from pgae_lite.world.words import VOCABULARY
 from pgae_lite.data.original import load_original
+from pgae_lite.data.simulated import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.data.simulated import (CorruptEpisodeError, episode_folder, generate,
-                               load_episode_file)
-from pgae_lite.train.loop import (CHECKPOINT, NonFiniteLossError, load_checkpoint,
-                             load_model, train)
-from pgae_lite.util.storage import (LOCK_FILE, CorruptCheckpointError, FolderBusyError,
-                             OutputError, atomic_write_text, save_torch)
+from pgae_lite.runs import pipeline
+from pgae_lite.train.loop import CHECKPOINT, NonFiniteLossError, load_checkpoint, load_model, train
+from pgae_lite.util.storage import (
+    LOCK_FILE,
+    CorruptCheckpointError,
+    FolderBusyError,
+    OutputError,
+    atomic_write_text,
+    save_torch,
+)
+from pgae_lite.world.words import VOCABULARY
 
 SAMPLE = Path("201207") / "target000000.txt"     # pattern 0: training, 100 steps
 ROOT = str(Path(pgae_lite.__file__).resolve().parents[1])

@@ -8,9 +8,23 @@ import pytest
 import torch
 
 from pgae_lite.world import words as L
-from pgae_lite.world.words import (BOS_EOS, INPUT_DIM, SIGNALS, VOCABULARY, LanguageError, decode, encode,
-                                equivalent_descriptions, is_correct, normalise_signal, one_hot,
-                                parse_description, signal_index, tokenize, word_weights)
+from pgae_lite.world.words import (
+    BOS_EOS,
+    INPUT_DIM,
+    SIGNALS,
+    VOCABULARY,
+    LanguageError,
+    decode,
+    encode,
+    equivalent_descriptions,
+    is_correct,
+    normalise_signal,
+    one_hot,
+    parse_description,
+    signal_index,
+    tokenize,
+    word_weights,
+)
 
 AUTHORS_VOCABULARY = (
     "<BOS/EOS>", "azure", "blonde", "blue", "cyan", "fast", "green", "greenish-blue", "harlequin",

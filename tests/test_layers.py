@@ -6,8 +6,15 @@ import math
 import pytest
 import torch
 
-from pgae_lite.model.layers import (FusedLSTM, GatedMultimodalUnit, PeepholeLSTM, PeepholeLSTMCell, make_recurrent,
-                              state_to_vector, vector_to_state)
+from pgae_lite.model.layers import (
+    FusedLSTM,
+    GatedMultimodalUnit,
+    PeepholeLSTM,
+    PeepholeLSTMCell,
+    make_recurrent,
+    state_to_vector,
+    vector_to_state,
+)
 
 CLASSES = [PeepholeLSTM, FusedLSTM]
 
@@ -133,8 +140,8 @@ def test_step_agrees_with_forward(cls):
 
 def test_fused_lstm_forget_bias_and_init():
     rnn = FusedLSTM(3, 4, num_layers=2)
-    for l in range(2):
-        b = getattr(rnn.lstm, f"bias_ih_l{l}")
+    for layer in range(2):
+        b = getattr(rnn.lstm, f"bias_ih_l{layer}")
         assert (b[4:8] >= 0.7).all() and (b[4:8] <= 0.9).all()       # forget gate: U(-0.1, 0.1) + 0.8
         assert b[:4].abs().max() <= 0.1 and b[8:].abs().max() <= 0.1
 

@@ -38,6 +38,7 @@ def test_every_cell_has_a_unique_id(path):
     """nbformat 4.5 requires cell ids; a missing one is a warning in CI today and an error in later nbformat."""
     cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
     missing = [i for i, cell in enumerate(cells) if not cell.get("id")]
-    assert not missing, f"{path.name}: cells {missing} have no id; give each a unique \"id\" (e.g. nbformat.validator.normalize)"
+    assert not missing, (f"{path.name}: cells {missing} have no id; give each a unique \"id\" "
+                         "(e.g. nbformat.validator.normalize)")
     ids = [cell["id"] for cell in cells]
     assert len(set(ids)) == len(ids), f"{path.name}: cell ids repeat: {sorted({i for i in ids if ids.count(i) > 1})}"

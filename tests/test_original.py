@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from pgae_lite.data.dataset import DataFormatError
-from pgae_lite.world.words import SIGNALS, VOCABULARY
 from pgae_lite.data.original import load_original
 from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 
 def test_load_original(original):

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from pgae_lite.data.dataset import description_text
-from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, VOCABULARY, equivalent_descriptions
 from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number, pattern_parts
+from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, VOCABULARY, equivalent_descriptions
 
 PATTERNS = [Pattern.from_number(i) for i in range(144)]
 

@@ -44,10 +44,8 @@ def test_several_models_train_side_by_side_and_then_load():
 
     import torch
 
-    from pgae_lite.config import training_profile
+    from pgae_lite.config import TRAININGS, training_profile
     from pgae_lite.runs.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
-
-    from pgae_lite.config import TRAININGS
     from pgae_lite.runs.trainings import NO_PLAN
 
     for training in (TRAININGS["PGAE"], NO_PLAN):     # left by an earlier run of this test in the same cache
@@ -70,8 +68,8 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
     import subprocess
     import sys
 
-    from pgae_lite.runs import pipeline
     from pgae_lite.config import training_profile
+    from pgae_lite.runs import pipeline
 
     folder = pipeline._model_folder(training_profile(get_profile("smoke", seed=7), "PGAE"), "PGAE")
     shutil.rmtree(folder, ignore_errors=True)        # not trained yet (a trained one loads without waiting)
@@ -91,9 +89,8 @@ def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(mo
 
     import pgae_lite.bert.phrase_lexicon as phrase_lexicon
     from pgae_lite.config import training_profile
-    from pgae_lite.util.storage import config_digest
-
     from pgae_lite.runs.trainings import PHRASINGS
+    from pgae_lite.util.storage import config_digest
 
     prof = training_profile(get_profile("smoke"), PHRASINGS)
     before = pipeline._model_folder(prof, "PGAE-BERT-phrasings")

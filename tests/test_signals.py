@@ -4,9 +4,18 @@ from __future__ import annotations
 import pytest
 import torch
 
+from pgae_lite.model.signals import (
+    DESCRIBE,
+    EXECUTE,
+    REPEAT_ACTION,
+    REPEAT_BOTH,
+    REPEAT_LANGUAGE,
+    SIGNAL_PROBS,
+    make_batch,
+    sample_signals,
+    signal_ids,
+)
 from pgae_lite.world.words import SIGNALS, VOCABULARY
-from pgae_lite.model.signals import (DESCRIBE, EXECUTE, REPEAT_ACTION, REPEAT_BOTH, REPEAT_LANGUAGE, SIGNAL_PROBS,
-                               make_batch, sample_signals, signal_ids)
 
 # A fast (50-step) and a slow (100-step) sample of the toy set, and another fast one.
 INDEX = torch.tensor([72, 0, 100])

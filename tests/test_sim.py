@@ -12,11 +12,24 @@ import pybullet as p
 import pytest
 from pybullet_utils import bullet_client
 
-from pgae_lite.world.words import COLOURS
-from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
-from pgae_lite.sim import (CUBE_RGBA, HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot, Scene, SceneLayout, SimConfig,
-                           Simulation, check_action, episode_seed, execute_trajectory, record_episode)
+from pgae_lite.sim import (
+    CUBE_RGBA,
+    HOME_POSE,
+    JOINT_LIMITS,
+    JOINT_NAMES,
+    Robot,
+    Scene,
+    SceneLayout,
+    SimConfig,
+    Simulation,
+    check_action,
+    episode_seed,
+    execute_trajectory,
+    record_episode,
+)
 from pgae_lite.sim.robot import REST_POSE
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
+from pgae_lite.world.words import COLOURS
 
 FAST = pattern_number(1, 0, 0)   # pattern numbers from 72 on are the fast (50-step) ones
 

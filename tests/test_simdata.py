@@ -6,9 +6,15 @@ import pytest
 
 from pgae_lite.config import SMOKE_PATTERNS
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.simulated import (
+    CorruptEpisodeError,
+    DatasetConfig,
+    episode_folder,
+    generate,
+    load_episode,
+    load_episode_file,
+)
 from pgae_lite.world.patterns import Pattern
-from pgae_lite.data.simulated import (CorruptEpisodeError, DatasetConfig, episode_folder, generate, load_episode,
-                               load_episode_file)
 
 
 def test_smoke_dataset_is_recorded_with_the_papers_split(smoke_episodes):

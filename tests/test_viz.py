@@ -10,12 +10,19 @@ import torch
 from matplotlib.figure import Figure
 
 from pgae_lite.data.dataset import Normaliser
-from pgae_lite.evaluate import Predictions
-from pgae_lite.world.words import SIGNALS
-from pgae_lite.model.signals import make_batch
 from pgae_lite.data.toy import toy_dataset
-from pgae_lite.viz import (plot_gates, plot_history, plot_joints, plot_vision, prediction_frame,
-                           signal_table, wrong_words)
+from pgae_lite.evaluate import Predictions
+from pgae_lite.model.signals import make_batch
+from pgae_lite.viz import (
+    plot_gates,
+    plot_history,
+    plot_joints,
+    plot_vision,
+    prediction_frame,
+    signal_table,
+    wrong_words,
+)
+from pgae_lite.world.words import SIGNALS
 
 
 @pytest.fixture(scope="module")
@@ -102,8 +109,8 @@ def test_animate_frames_plays_every_nth_step_and_embeds_offline():
 
 
 def test_plot_patterns_labels_all_144_and_outlines_test_patterns():
-    from pgae_lite.world.patterns import TEST_PATTERNS
     from pgae_lite.viz import plot_patterns
+    from pgae_lite.world.patterns import TEST_PATTERNS
 
     fig = plot_patterns(marked=(0, 1, 2))
     labels = {t.get_text() for t in fig.axes[0].texts}

@@ -8,17 +8,17 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.world import words as L
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.data.dataset import Normaliser, from_recordings
+from pgae_lite.data.simulated import GENERATOR_VERSION, DatasetConfig
 from pgae_lite.evaluate import Predictions
 from pgae_lite.exercises import check_new_colour
-from pgae_lite.world.words import DEFAULT_LEXICON, LanguageError
-from pgae_lite.world.patterns import TEST_PATTERNS, Pattern
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.data.simulated import GENERATOR_VERSION, DatasetConfig
 from pgae_lite.util.storage import config_digest
+from pgae_lite.world import words as L
 from pgae_lite.world.colours import DEFAULT_WORLD, World, with_colour
+from pgae_lite.world.patterns import TEST_PATTERNS, Pattern
+from pgae_lite.world.words import DEFAULT_LEXICON, LanguageError
 
 ORANGE = (0.98, 0.50, 0.05, 1.0)
 WORLD = with_colour("orange", "amber", ORANGE)

@@ -21,9 +21,9 @@ import numpy as np
 import torch
 
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.world.words import VOCABULARY
-from pgae_lite.world.patterns import MAX_STEPS, Pattern
 from pgae_lite.util.storage import array_digest, atomic_write
+from pgae_lite.world.patterns import MAX_STEPS, Pattern
+from pgae_lite.world.words import VOCABULARY
 
 JOINT_DIM = 5
 VISION_DIM = 30

@@ -16,11 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
+from pgae_lite.data.checks import JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range, check_vocabulary, read_rows
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
-from pgae_lite.world.words import VOCABULARY
 from pgae_lite.world.patterns import MAX_STEPS, Pattern
-from pgae_lite.data.checks import (JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range,
-                            check_vocabulary, read_rows)
+from pgae_lite.world.words import VOCABULARY
 
 _SUBTREES = ("behavior", "vision", "vision_opp", "language")
 
@@ -78,7 +77,8 @@ def load_original(path: str | Path) -> PGAEDataset:
                 words = _descriptions(lang_file, lang, pattern)
                 action, arrangement, split_name = pattern_info[pattern]
                 if split_name != split:
-                    raise DataFormatError(f"{rel}: actions.txt puts pattern {pattern} in {split_name}, found in {split}")
+                    raise DataFormatError(f"{rel}: actions.txt puts pattern {pattern} in {split_name}, "
+                                          f"found in {split}")
                 pad = ((0, MAX_STEPS - n), (0, 0))
                 rows["joints"].append(np.pad(joints, pad))
                 rows["vision"].append(np.pad(vision, pad))

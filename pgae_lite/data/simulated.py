@@ -40,10 +40,9 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from pgae_lite.data.dataset import PGAEDataset, from_recordings
-from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.sim.record import Episode, SimConfig, record_episode
-from pgae_lite.util.storage import (array_digest, atomic_write, atomic_write_text, cache_dir,
-                    config_digest)
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.storage import array_digest, atomic_write, atomic_write_text, cache_dir, config_digest
 from pgae_lite.world.colours import DEFAULT_WORLD, World
 
 #: Bump when the simulator changes what it records: old caches are then not reused.
@@ -299,7 +298,10 @@ def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ..
 
 def to_dataset(config: DatasetConfig, features: Callable[[np.ndarray], np.ndarray],
                progress: bool = True) -> PGAEDataset:
-    """The episodes as a :class:`~pgae_lite.data.dataset.PGAEDataset`; ``features`` maps frames (T,120,160,3) -> (T,30)."""
+    """The episodes as a :class:`~pgae_lite.data.dataset.PGAEDataset`.
+
+    ``features`` maps an episode's frames (T, 120, 160, 3) to its visual features (T, 30).
+    """
     episodes = tqdm(iter_episodes(config), total=len(config.episodes()), desc="visual features",
                     unit="ep", disable=not progress)
     world = config.the_world

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from pgae_lite.data.dataset import PGAEDataset, from_recordings
-from pgae_lite.world.words import COLOURS
 from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import COLOURS
 
 
 def _min_jerk(tau: np.ndarray) -> np.ndarray:

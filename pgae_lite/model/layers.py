@@ -52,8 +52,8 @@ class PeepholeLSTM(nn.Module):
         super().__init__()
         self.hidden_size, self.num_layers = hidden_size, num_layers
         self.cells = nn.ModuleList(
-            PeepholeLSTMCell(input_size if l == 0 else hidden_size, hidden_size, forget_bias)
-            for l in range(num_layers))
+            PeepholeLSTMCell(input_size if layer == 0 else hidden_size, hidden_size, forget_bias)
+            for layer in range(num_layers))
 
     @property
     def input_weight(self) -> nn.Parameter:
@@ -77,9 +77,9 @@ class PeepholeLSTM(nn.Module):
         if lengths is not None:  # (T, batch, 1) True where step t is inside the sequence
             valid = (torch.arange(steps, device=x.device)[:, None] < lengths.to(x.device)[None, :])[..., None]
         layer_in, hs, cs = x, [], []
-        for l, cell in enumerate(self.cells):
+        for layer, cell in enumerate(self.cells):
             gates_x = (layer_in @ cell.weight_x + cell.bias).unbind(1)  # T x (batch, 4H)
-            h, c = h0[l], c0[l]
+            h, c = h0[layer], c0[layer]
             outs = []
             for t in range(steps):
                 h_new, c_new = cell(gates_x[t], h, c)
@@ -97,8 +97,8 @@ class PeepholeLSTM(nn.Module):
         """One time step for all layers: x_t (batch, input) -> output (batch, H), new state."""
         h0, c0 = state
         hs, cs, inp = [], [], x_t
-        for l, cell in enumerate(self.cells):
-            h, c = cell(inp @ cell.weight_x + cell.bias, h0[l], c0[l])
+        for layer, cell in enumerate(self.cells):
+            h, c = cell(inp @ cell.weight_x + cell.bias, h0[layer], c0[layer])
             hs.append(h)
             cs.append(c)
             inp = h
@@ -119,8 +119,8 @@ class FusedLSTM(nn.Module):
         for p in self.lstm.parameters():
             nn.init.uniform_(p, -0.1, 0.1)
         with torch.no_grad():  # PyTorch's gate order is i, f, g, o: add the forget bias once
-            for l in range(num_layers):
-                getattr(self.lstm, f"bias_ih_l{l}")[hidden_size:2 * hidden_size] += forget_bias
+            for layer in range(num_layers):
+                getattr(self.lstm, f"bias_ih_l{layer}")[hidden_size:2 * hidden_size] += forget_bias
 
     @property
     def input_weight(self) -> nn.Parameter:
@@ -150,9 +150,9 @@ class FusedLSTM(nn.Module):
         # One cell call per layer with nn.LSTM's own weights: cheaper than a length-1 nn.LSTM call.
         h0, c0 = state
         hs, cs, inp = [], [], x_t
-        for l in range(self.num_layers):
-            weights = [getattr(self.lstm, f"{n}_l{l}") for n in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")]
-            h, c = torch._VF.lstm_cell(inp, (h0[l], c0[l]), *weights)
+        for layer in range(self.num_layers):
+            weights = [getattr(self.lstm, f"{n}_l{layer}") for n in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")]
+            h, c = torch._VF.lstm_cell(inp, (h0[layer], c0[layer]), *weights)
             hs.append(h)
             cs.append(c)
             inp = h
@@ -171,7 +171,7 @@ def make_recurrent(cell: str, input_size: int, hidden_size: int, num_layers: int
 def state_to_vector(state: State) -> torch.Tensor:
     """Final (h, c) of every layer -> [c_0; h_0; c_1; h_1] (batch, 2 x layers x H), the authors' order."""
     h, c = state
-    return torch.cat([t for l in range(h.shape[0]) for t in (c[l], h[l])], dim=1)
+    return torch.cat([t for layer in range(h.shape[0]) for t in (c[layer], h[layer])], dim=1)
 
 
 def vector_to_state(v: torch.Tensor, num_layers: int) -> State:

@@ -32,8 +32,8 @@ import torch
 from torch import nn
 
 from pgae_lite.data.dataset import JOINT_DIM, Normaliser, PGAEDataset
-from pgae_lite.world.patterns import Pattern
 from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH, make_batch, signal_ids
+from pgae_lite.world.patterns import Pattern
 
 #: The signals whose action target is the whole motion: their h must carry the plan.
 PLAN_SIGNALS = (EXECUTE, REPEAT_ACTION, REPEAT_BOTH)

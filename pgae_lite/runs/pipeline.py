@@ -25,11 +25,11 @@ from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
+from pgae_lite.bert.phrase_lexicon import training_lexicon
+from pgae_lite.bert.phrasings import phrasings_digest
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from pgae_lite.config import Profile, Training, as_training, get_profile, training_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
-from pgae_lite.bert.phrase_lexicon import training_lexicon
-from pgae_lite.bert.phrasings import phrasings_digest
 from pgae_lite.data.simulated import DatasetConfig, generate, to_dataset, training_frames
 from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest
 
@@ -185,7 +185,8 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
     if cpu and workers > 1:
         simulated_dataset(prof, device, progress)         # recorded and encoded once, before the workers read it
         if progress:
-            print(f"training {', '.join(t.name for t in todo)} side by side, {workers} at a time, one core each ...", flush=True)
+            names = ", ".join(t.name for t in todo)
+            print(f"training {names} side by side, {workers} at a time, one core each ...", flush=True)
         with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
             for training, seconds in zip(todo, pool.map(_train_alone, todo, [prof] * len(todo),
                                                         [seed] * len(todo))):

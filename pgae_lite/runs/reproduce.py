@@ -34,16 +34,15 @@ from pathlib import Path
 
 import numpy as np
 
-from pgae_lite.config import ROWS, TRAININGS, Profile, get_profile, training_profile  # TRAININGS: the README names it here
-from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.util.errors import ArgumentError
-from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table
-from pgae_lite.world.words import TEST_SIGNALS
 from pgae_lite.bert.pretrained import model_source
+from pgae_lite.config import ROWS, Profile, get_profile, training_profile
+from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table
 from pgae_lite.train.loop import train
-from pgae_lite.util.storage import atomic_write, atomic_write_text
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
-
+from pgae_lite.util.errors import ArgumentError
+from pgae_lite.util.storage import atomic_write, atomic_write_text
+from pgae_lite.world.words import TEST_SIGNALS
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
 CELLS = ("accuracy", "nrmse", "nrmse_padded")

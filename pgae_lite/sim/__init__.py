@@ -21,8 +21,17 @@ with silenced(2):  # pybullet announces its build time on stderr when first impo
     import pybullet  # noqa: F401
 
 from pgae_lite.sim.actions import ActionCheck, check_action
-from pgae_lite.sim.record import (AGENTS, Episode, Execution, SimConfig, Simulation, episode_seed, execute_trajectory,
-                     record_episode, scene_layout)
+from pgae_lite.sim.record import (
+    AGENTS,
+    Episode,
+    Execution,
+    SimConfig,
+    Simulation,
+    episode_seed,
+    execute_trajectory,
+    record_episode,
+    scene_layout,
+)
 from pgae_lite.sim.robot import HOME_POSE, JOINT_LIMITS, JOINT_NAMES, Robot
 from pgae_lite.sim.scene import CUBE_RGBA, Scene, SceneLayout
 

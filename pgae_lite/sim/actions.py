@@ -33,9 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from pgae_lite.world.words import ACTIONS
 from pgae_lite.sim.robot import HOME_POSE, Robot
 from pgae_lite.sim.scene import CUBE_SIZE
+from pgae_lite.world.words import ACTIONS
 
 # Where the hand touches the cube: distance from the cube centre to the fingertip
 # point, against the direction of motion (m). The hand is a 2.5 x 4.5 cm paddle

@@ -33,12 +33,22 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from pgae_lite.world.patterns import NUMBERING, Pattern
-from pgae_lite.world.colours import DEFAULT_WORLD, EXTENSION_NUMBERING, World
-from pgae_lite.sim.actions import (MAX_OFF_AXIS_RATIO, MAX_OTHER_MOVE, MIN_MOVE, ActionCheck, Plan, Variation,
-                      check_action, plan_action, sample_variation, world_direction)
+from pgae_lite.sim.actions import (
+    MAX_OFF_AXIS_RATIO,
+    MAX_OTHER_MOVE,
+    MIN_MOVE,
+    ActionCheck,
+    Plan,
+    Variation,
+    check_action,
+    plan_action,
+    sample_variation,
+    world_direction,
+)
 from pgae_lite.sim.robot import JOINT_LIMITS, JOINT_NAMES, Robot
 from pgae_lite.sim.scene import CUBE_Y, IMAGE_HEIGHT, IMAGE_WIDTH, TABLE_CENTRE_X, Scene, SceneLayout
+from pgae_lite.world.colours import DEFAULT_WORLD, EXTENSION_NUMBERING, World
+from pgae_lite.world.patterns import NUMBERING, Pattern
 
 AGENTS = ("nico", "opposite")
 log = logging.getLogger(__name__)

@@ -35,9 +35,9 @@ import numpy as np
 import pybullet as p
 from pybullet_utils import bullet_client
 
-from pgae_lite.world.words import COLOURS
 from pgae_lite.sim._quiet import silenced
 from pgae_lite.sim.robot import Robot
+from pgae_lite.world.words import COLOURS
 
 #: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.world.words`.
 CUBE_RGBA: dict[str, tuple[float, float, float, float]] = {

@@ -15,11 +15,29 @@ changes the model or the data.
 Every public function is importable from here, e.g. ``from pgae_lite.viz import plot_gates``.
 """
 from pgae_lite.viz.embeddings import WORD_COLOURS, plot_point_map, plot_similarity
-from pgae_lite.viz.model import (SIGNAL_COLOURS, plot_gates, plot_histories, plot_history, plot_joints, plot_mean_gates,
-                    plot_word_confusion, prediction_frame, signal_table, word_confusion, wrong_words)
+from pgae_lite.viz.model import (
+                    SIGNAL_COLOURS,
+                    plot_gates,
+                    plot_histories,
+                    plot_history,
+                    plot_joints,
+                    plot_mean_gates,
+                    plot_word_confusion,
+                    prediction_frame,
+                    signal_table,
+                    word_confusion,
+                    wrong_words,
+)
 from pgae_lite.viz.scenes import animate_frames, plot_frames, plot_joints_by_action, plot_patterns
-from pgae_lite.viz.vision import (CHANNEL_COLOURS, plot_cae_history, plot_channels, plot_feature_rows, plot_features_over_time,
-                     plot_reconstructions, plot_vision)
+from pgae_lite.viz.vision import (
+                    CHANNEL_COLOURS,
+                    plot_cae_history,
+                    plot_channels,
+                    plot_feature_rows,
+                    plot_features_over_time,
+                    plot_reconstructions,
+                    plot_vision,
+)
 
 __all__ = ["plot_frames", "animate_frames", "plot_patterns", "plot_joints_by_action",
            "CHANNEL_COLOURS", "plot_channels", "plot_reconstructions", "plot_cae_history", "plot_features_over_time",

@@ -17,9 +17,9 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
 from pgae_lite.data.dataset import PGAEDataset, description_text
-from pgae_lite.world.words import CANONICAL, SIGNALS, SLOT_NAMES, SLOTS, VOCABULARY
 from pgae_lite.model.signals import SignalBatch
 from pgae_lite.viz._common import JOINT_NAMES, _numpy
+from pgae_lite.world.words import CANONICAL, SIGNALS, SLOT_NAMES, SLOTS, VOCABULARY
 
 #: One colour per signal, the same in every figure of the book.
 SIGNAL_COLOURS: dict[str, str] = {

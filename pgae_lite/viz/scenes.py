@@ -13,8 +13,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, TEST_PATTERNS, pattern_parts
 from pgae_lite.viz._common import JOINT_NAMES, _numpy
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, TEST_PATTERNS, pattern_parts
+
 
 def plot_frames(rows: Mapping[str, np.ndarray], count: int = 6, size: float = 1.7) -> Figure:
     """Film strips: ``count`` evenly spaced frames of each sequence, one row per entry of ``rows``.

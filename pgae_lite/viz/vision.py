@@ -183,7 +183,8 @@ def plot_feature_rows(frames: Mapping[str, np.ndarray], features: np.ndarray | t
         _feature_edges(axes[r, 1], width, horizontal=False)
         axes[r, 1].set(yticks=[], xticks=[])
     per = width // 3
-    axes[-1, 1].set_xticks([per / 2 - 0.5, 1.5 * per - 0.5, 2.5 * per - 0.5], ["R features", "G features", "B features"])
+    axes[-1, 1].set_xticks([per / 2 - 0.5, 1.5 * per - 0.5, 2.5 * per - 0.5],
+                           ["R features", "G features", "B features"])
     fig.colorbar(im, ax=axes[:, 1], pad=0.01, fraction=0.03)
     return fig
 

@@ -30,10 +30,17 @@ from typing import Sequence
 
 import numpy as np
 
-from pgae_lite.world.words import DEFAULT_LEXICON, Lexicon, LanguageError, equivalent_descriptions
-from pgae_lite.world.patterns import (ACTION_SIDES, ARRANGEMENTS, NUMBERING, TEST_PATTERNS, Pattern,
-                       pattern_number, pattern_parts)
 from pgae_lite.util.storage import config_digest
+from pgae_lite.world.patterns import (
+    ACTION_SIDES,
+    ARRANGEMENTS,
+    NUMBERING,
+    TEST_PATTERNS,
+    Pattern,
+    pattern_number,
+    pattern_parts,
+)
+from pgae_lite.world.words import DEFAULT_LEXICON, LanguageError, Lexicon, equivalent_descriptions
 
 #: The paper's patterns: 0-143 (:data:`pgae_lite.world.patterns.NUMBERING`).
 PAPER_PATTERNS = 144
