@@ -32,7 +32,7 @@ from pgae_lite.config import get_profile
 from pgae_lite.robot.instructions import execute_paraphrases
 from pgae_lite.world.words import LanguageError
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.train.loop import load_model
+from pgae_lite.train.checkpoint import load_model
 
 
 def main() -> None:

@@ -25,7 +25,7 @@ from pgae_lite.world.words import word_weights
 from pgae_lite.data.original import load_original
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import make_batch, sample_signals
-from pgae_lite.train.loop import pgae_loss
+from pgae_lite.train.loss import pgae_loss
 
 
 def seconds_per_step(model: PGAE, tensors: dict, samples: int, batch: int, seed: int, budget: float) -> float:

@@ -22,6 +22,7 @@ from pathlib import Path
 import torch
 
 import pgae_lite.train.loop as training
+from pgae_lite.train.checkpoint import load_model
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH
 
@@ -81,7 +82,7 @@ def main() -> None:
         data = simulated_dataset("book", progress=False)
         cae, _ = trained_cae("book", progress=False)
         folder = Path(rest[rest.index("--save") + 1])
-        model, normaliser, _ = training.load_model(next(folder.glob("*.pt")), dataset=data)
+        model, normaliser, _ = load_model(next(folder.glob("*.pt")), dataset=data)
         table = compare(model, cae, normaliser, data, limit=ours.episodes, progress=False)
         print(success_summary(table).round(2).to_string())
 

@@ -21,7 +21,7 @@ from pgae_lite.robot.closedloop import _drive, _simulation, _start, execute_batc
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import description_text
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
-from pgae_lite.train.loop import load_model
+from pgae_lite.train.checkpoint import load_model
 
 
 @torch.no_grad()

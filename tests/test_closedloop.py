@@ -44,7 +44,7 @@ def smoke(smoke_episodes):
     """The smoke dataset, its CAE and a PGAE trained on it for a few seconds."""
     data = simulated_dataset("smoke", "cpu", progress=False)
     cae, _ = trained_cae("smoke", "cpu", progress=False)
-    trained = train(data, "smoke", device="cpu", progress=False)
+    trained = train(data, get_profile("smoke"), device="cpu", progress=False)
     return data, cae, trained.model, trained.normaliser
 
 

@@ -34,7 +34,8 @@ from pgae_lite.data.original import load_original
 from pgae_lite.data.simulated import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs import pipeline
-from pgae_lite.train.loop import CHECKPOINT, NonFiniteLossError, load_checkpoint, load_model, train
+from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint, load_model
+from pgae_lite.train.loop import NonFiniteLossError, train
 from pgae_lite.util.storage import (
     LOCK_FILE,
     CorruptCheckpointError,

@@ -38,7 +38,7 @@ def smoke(smoke_episodes):
     profile = get_profile("smoke")
     profile.model.language_encoder = "pretrained"
     bert = train(data, profile, device="cpu", progress=False)
-    lstm = train(data, "smoke", device="cpu", progress=False)
+    lstm = train(data, get_profile("smoke"), device="cpu", progress=False)
     return data, cae, bert, lstm
 
 

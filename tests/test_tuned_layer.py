@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.world.words import SIGNALS
@@ -16,7 +17,9 @@ from pgae_lite.bert.phrasing_bank import MEANINGS, PhrasingBank
 from pgae_lite.bert.phrasings import phrasings
 from pgae_lite.bert.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
 from pgae_lite.model.signals import make_batch
-from pgae_lite.train.loop import load_checkpoint, load_model, parameter_groups, train
+from pgae_lite.train.checkpoint import load_checkpoint, load_model
+from pgae_lite.train.loss import parameter_groups
+from pgae_lite.train.loop import train
 from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
@@ -28,7 +31,7 @@ TEXTS = ["repeat language could you please shove the crimson block away from you
 
 @pytest.fixture(scope="module")
 def tuned() -> PGAE:
-    return PGAE(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention", tuned_top_layer=True))
+    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention", tuned_top_layer=True))
 
 
 def test_the_copy_reproduces_the_transformers_top_layer():
@@ -118,7 +121,8 @@ def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path, interr
     interrupt_training(toy_short, profile, tmp_path / "cut", epoch=3)
     resumed = train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu")
     for name, weight in whole.model.state_dict().items():
-        assert torch.equal(weight, resumed.model.state_dict()[name]), name
+        other = resumed.model.state_dict()[name]
+        assert (torch.equal(weight, other) if torch.is_tensor(weight) else weight == other), name
 
 
 def test_clear_errors_and_the_keys_of_models_before():

@@ -95,3 +95,26 @@ def test_evidence_only_from_the_training_lexicon():
 def test_training_sentences_count_as_known(held_out):
     assert not held_out.is_known("zorbly")
     assert WordLookup(training_lexicon("held-out"), ["repeat language zorbly the cube"]).is_known("zorbly")
+
+
+def test_a_saved_variant_reads_words_never_trained_on_as_the_trained_one(toy_short, tmp_path):
+    """The lookup is the encoder's, saved with its weights: a checkpoint loaded with load_model reads
+    words never trained on as the model the training returned (and trained_pgae loads) does."""
+    import torch
+
+    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.runs.trainings import PHRASINGS_HELD_OUT
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint, load_model
+    from pgae_lite.train.loop import train
+
+    profile = training_profile(get_profile("smoke"), PHRASINGS_HELD_OUT)
+    profile.train = replace(profile.train, epochs=1, phrasings=2)
+    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
+    loaded, _, _ = load_model(tmp_path / CHECKPOINT, device="cpu")
+    text = "repeat language could you draw the amethyst block closer?"
+    for model in (trained.model, loaded):
+        assert model.language_encoder.read_as(text) == "repeat language could you pull the purple block closer?"
+    torch.testing.assert_close(loaded.language_encoder.encode_texts([text]),
+                               trained.model.language_encoder.encode_texts([text]), rtol=0, atol=0)
+    saved = load_checkpoint(tmp_path / CHECKPOINT)["model"]["language_encoder._extra_state"]["word_lookup"]
+    assert "amethyst" not in saved["known"] and "purple" in saved["known"]       # plain strings, weights_only

@@ -28,11 +28,19 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from pgae_lite.bert.pretrained import (Transformer, check_texts, fixed_inputs, load_transformer, model_name, table_rows,
-                         token_vectors, tokens_to_text)
+from pgae_lite.bert.pretrained import (
+    Transformer,
+    check_texts,
+    fixed_inputs,
+    load_transformer,
+    model_name,
+    table_rows,
+    token_vectors,
+    tokens_to_text,
+)
 from pgae_lite.bert.tuned_layer import TunedTopLayer
-from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 from pgae_lite.bert.word_lookup import WordLookup
+from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 
 #: Attention heads (K). Deviation from paper: chosen on generated validation sentences
 #: (experiments/validation_readback.py's grammar seed), never on the test paraphrases.
@@ -94,6 +102,7 @@ class AttentivePretrainedEncoder(nn.Module):
     """
 
     pooling = "attention"
+    reads_free_text = True
 
     def __init__(self, name: str | None = None, heads: int = HEADS, tuned: bool = False):
         super().__init__()
@@ -108,8 +117,18 @@ class AttentivePretrainedEncoder(nn.Module):
         # free text only: the top layer, trained (tuned_layer.py); None = frozen
         self.top = TunedTopLayer(self.transformer) if tuned else None
         self._row_of_text = {text: i for i, text in enumerate(self.texts)}
-        # set by a training on phrasings: free text's unknown words looked up first (word_lookup.py)
+        # given by a training on phrasings (phrasing_bank.for_training), saved with the weights (get_extra_state):
+        # free text's unknown words looked up first (word_lookup.py)
         self.word_lookup: WordLookup | None = None
+
+    def get_extra_state(self) -> dict:
+        """Saved in the state dict beside the weights: the word lookup, as plain strings."""
+        return {"word_lookup": None if self.word_lookup is None else self.word_lookup.state()}
+
+    def set_extra_state(self, state: dict) -> None:
+        """A loaded model reads free text as the trained one did: with the same word lookup."""
+        saved = state.get("word_lookup") if isinstance(state, dict) else None
+        self.word_lookup = None if saved is None else WordLookup.from_state(saved)
 
     @property
     def transformer(self) -> Transformer:
@@ -143,12 +162,17 @@ class AttentivePretrainedEncoder(nn.Module):
                 states = self.top(states, mask)                              # (B, T', D)
         return self.pool(states, mask)
 
-    def encode_texts(self, texts: list[str]) -> torch.Tensor:
-        """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``."""
-        texts = check_texts("encode_texts", texts)
+    def read_as(self, text: str) -> str:
+        """The text as this encoder reads it: with its word lookup, unknown words replaced."""
         # Deviation from paper: unknown words looked up in WordNet first ("amethyst cube" -> "purple cube")
-        if self.word_lookup is not None:
-            texts = [self.word_lookup.rewrite(text) for text in texts]
+        return text if self.word_lookup is None else self.word_lookup.rewrite(text)
+
+    def encode_texts(self, texts: list[str]) -> torch.Tensor:
+        """Any texts -> f (B, output_dim), the signal phrase first: ``["execute push the red one"]``.
+
+        Each text is read as :meth:`read_as` gives it (the lookup's rewrite changes a text once: the
+        words it puts in are training words)."""
+        texts = [self.read_as(text) for text in check_texts("encode_texts", texts)]
         if self.top is None:
             return self.pool(*padded_token_vectors(self.transformer, texts))
         # a fixed input (a description, e.g. said back) reads the frozen layer's output, as in training

@@ -14,9 +14,9 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, fields, replace
 
+from pgae_lite.util.checks import instance_of
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, SYNONYMS, VOCABULARY
-from pgae_lite.util.checks import instance_of
 
 SLOTS = ("action", "colour", "speed")
 #: The meanings each slot may say.

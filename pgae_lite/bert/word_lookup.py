@@ -43,10 +43,11 @@ from __future__ import annotations
 
 import re
 from collections import Counter
+from dataclasses import asdict
 from functools import lru_cache
 
-from pgae_lite.world.words import SIGNALS, VOCABULARY
 from pgae_lite.bert.phrase_lexicon import SLOTS, PhraseLexicon, words_of
+from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 #: Function words: never looked up (the closed classes of English, written for this purpose).
 FUNCTION_WORDS = frozenset("""
@@ -96,6 +97,7 @@ class WordLookup:
     """
 
     def __init__(self, lexicon: PhraseLexicon, sentences: list[str] = ()):
+        self.lexicon = lexicon
         self.known = set(FUNCTION_WORDS) | lexicon.words()
         for text in (*SIGNALS, *VOCABULARY, *sentences):
             self.known.update(words_of(text))
@@ -108,6 +110,17 @@ class WordLookup:
         self.in_definitions = set(self.meaning_of) - directions
         self._targets: dict[str, str | None] = {}
         self._read_as: dict[str, str | None] = {}          # a word of a text -> its replacement (None: kept)
+
+    def state(self) -> dict:
+        """What rebuilds this lookup exactly, as plain strings (saved in a model's checkpoint)."""
+        return {"lexicon": asdict(self.lexicon), "known": sorted(self.known)}
+
+    @classmethod
+    def from_state(cls, state: dict) -> "WordLookup":
+        """The lookup :meth:`state` describes."""
+        lookup = cls(PhraseLexicon(**state["lexicon"]))
+        lookup.known = set(state["known"])
+        return lookup
 
     def is_known(self, word: str) -> bool:
         """Whether ``word`` (lower case) or a base form of it is in the training language."""

@@ -21,15 +21,17 @@ the paper: :func:`pgae_lite.world.colours.with_colour`); the default is the pape
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import torch
 from torch import nn
 
-from pgae_lite.model.config import LANGUAGE_ENCODERS, ModelConfig
 from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
-from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, Lexicon
+from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
 from pgae_lite.model.plan import PlanHead
 from pgae_lite.model.signals import SignalBatch
+from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, LanguageError, Lexicon
 
 WORDS = len(VOCABULARY)
 
@@ -57,7 +59,24 @@ class LanguageEncoder(nn.Module):
     The tokens are those of :func:`pgae_lite.model.signals.make_batch`: the signal s first, as
     token 23 + s, then word indices. With a lexicon of V > 23 words the signal's one-hot
     dimension is V + s (the words' come first), so the first token moves by V - 23.
+
+    Every language encoder PGAE reads has this interface: ``output_dim``, ``forward(tokens,
+    lengths)``, ``reads_free_text``, ``read_as(text)`` (the text as the encoder reads it) and
+    ``encode_texts(texts)``. This one reads the dataset's words only; the pretrained encoders of
+    :mod:`pgae_lite.bert` read any text.
     """
+
+    reads_free_text = False
+
+    def read_as(self, text: str) -> str:
+        """The text as this encoder reads it: as it is (it must be a description)."""
+        return text
+
+    def encode_texts(self, texts: list[str]) -> torch.Tensor:
+        """Free text: not for this encoder, which reads one-hot tokens of the dataset's words."""
+        raise LanguageError("PGAE's LSTM language encoder reads only the dataset's words, as tokens "
+                            "(pgae_lite.model.signals.make_batch); free text needs a pretrained encoder "
+                            "(ModelConfig language_encoder='pretrained' or 'pretrained-attention')")
 
     def __init__(self, cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
@@ -73,26 +92,6 @@ class LanguageEncoder(nn.Module):
         x = nn.functional.one_hot(tokens, self.input_dim).float()   # (B, 5, 28)
         _, state = self.rnn(x, lengths)
         return state_to_vector(state)                           # (B, 400)
-
-
-def make_language_encoder(cfg: ModelConfig,
-                          lexicon: Lexicon = DEFAULT_LEXICON) -> nn.Module:
-    """The language encoder ``cfg.language_encoder`` names; it has an ``output_dim``."""
-    if cfg.language_encoder == "lstm":
-        return LanguageEncoder(cfg, lexicon)
-    if cfg.language_encoder in ("pretrained", "pretrained-attention"):
-        if lexicon != DEFAULT_LEXICON:
-            raise ValueError("the pretrained language encoder (PGAE-BERT) reads the "
-                             "paper's 23 words only; use language_encoder='lstm' with "
-                             "a larger lexicon")
-        # Imported here: transformers loads only when PGAE-BERT is used.
-        if cfg.language_encoder == "pretrained-attention":   # not in the paper: attention_pooling.py
-            from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
-            return AttentivePretrainedEncoder(cfg.pretrained_model, tuned=cfg.tuned_top_layer)
-        from pgae_lite.bert.pretrained import PretrainedLanguageEncoder
-        return PretrainedLanguageEncoder(cfg.pretrained_model)
-    raise ValueError(f"unknown language_encoder {cfg.language_encoder!r}; "
-                     f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
 
 
 class ActionEncoder(nn.Module):
@@ -249,14 +248,22 @@ class PGAE(nn.Module):
     """The whole model: two encoders, the GMU, two decoders.
 
     ``lexicon``: the words it reads and writes (default: the paper's 23).
+    ``make_language_encoder(cfg, lexicon)``: builds the language encoder (default: the LSTM);
+    :func:`pgae_lite.bert.encoders.build_pgae` passes the pretrained ones.
     """
 
-    def __init__(self, cfg: ModelConfig | None = None,
-                 lexicon: Lexicon = DEFAULT_LEXICON):
+    def __init__(self, cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON,
+                 make_language_encoder: Callable[[ModelConfig, Lexicon], nn.Module] | None = None):
         super().__init__()
         self.cfg = cfg or ModelConfig()
         self.lexicon = lexicon
-        # LSTM (PGAE) or frozen transformer (PGAE-BERT)
+        # the LSTM (PGAE), or what make_language_encoder builds: a pretrained transformer (PGAE-BERT),
+        # passed in by pgae_lite.bert.encoders.build_pgae; built here, in this order, for the same weights
+        if make_language_encoder is None:
+            if self.cfg.language_encoder != "lstm":
+                raise ValueError(f"language_encoder={self.cfg.language_encoder!r} is built by pgae_lite.bert: "
+                                 "build the model with pgae_lite.bert.encoders.build_pgae(cfg)")
+            make_language_encoder = LanguageEncoder
         self.language_encoder = make_language_encoder(self.cfg, lexicon)
         self.action_encoder = ActionEncoder(self.cfg)
         self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden,

@@ -50,15 +50,15 @@ from tqdm.auto import tqdm
 from pgae_lite.cae import ChannelSeparatedCAE, extract_features
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
+from pgae_lite.data.simulated import DatasetConfig
 from pgae_lite.evaluate import predict
-from pgae_lite.world.words import WORD_INDEX, parse_description, tokenize
-from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
 from pgae_lite.sim.record import Execution, Simulation
 from pgae_lite.sim.robot import HOME_POSE
-from pgae_lite.data.simulated import DatasetConfig
 from pgae_lite.viz import animate_frames
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
+from pgae_lite.world.words import WORD_INDEX, parse_description, tokenize
 
 #: pybullet's default gain of a position motor (Robot.set_targets sets none): each physics
 #: step closes this share of the gap between the joint and its target.
@@ -264,9 +264,12 @@ def success_summary(table: pd.DataFrame) -> pd.DataFrame:
         for name, g in groups]).set_index("group")
 
 
-def pattern_for(description: str, arrangement: int) -> int:
-    """The pattern a description asks for in cube arrangement ``arrangement`` (0-11, see ARRANGEMENTS)."""
-    action, colour, speed = parse_description(description)
+def pattern_for(description: str | tuple[str, str, str], arrangement: int) -> int:
+    """The pattern a description asks for in cube arrangement ``arrangement`` (0-11, see ARRANGEMENTS).
+
+    ``description``: its text, or its parse (:func:`~pgae_lite.world.words.parse_description`'s).
+    """
+    action, colour, speed = parse_description(description) if isinstance(description, str) else description
     left, right = ARRANGEMENTS[arrangement]
     if colour not in (left, right):
         raise ValueError(f"there is no {colour} cube in arrangement {arrangement} ({left} left, {right} right)")

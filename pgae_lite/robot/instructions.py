@@ -17,17 +17,17 @@ import pandas as pd
 import torch
 from tqdm.auto import tqdm
 
-from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.evaluate import predict
-from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
 from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
-from pgae_lite.world.patterns import Pattern
-from pgae_lite.model.pgae import PGAE
 from pgae_lite.bert.pretrained import check_texts, input_text
-from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
+from pgae_lite.cae import ChannelSeparatedCAE
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.evaluate import predict
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
+from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
 
 
 @torch.no_grad()
@@ -40,7 +40,7 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
     else a :class:`~pgae_lite.world.words.LanguageError` names the unknown words.
     """
     texts, encoder = check_texts("instruction_features", texts), model.language_encoder
-    if hasattr(encoder, "encode_texts"):                          # PGAE-BERT
+    if encoder.reads_free_text:                                   # PGAE-BERT
         return encoder.encode_texts([input_text("execute", t) for t in texts])
     for t in texts:
         try:
@@ -68,7 +68,7 @@ def say_back(model: PGAE, data: PGAEDataset, normaliser: Normaliser, texts: list
     """Each instruction said back in the dataset's words (``repeat language``; sample i of ``data``
     carries text i, whose action the model is not shown), e.g. ``"push red fast"``."""
     texts = check_texts("say_back", texts)
-    if not hasattr(model.language_encoder, "encode_texts"):
+    if not model.language_encoder.reads_free_text:
         raise ValueError("saying back free text needs PGAE-BERT's pretrained encoder; PGAE's LSTM reads "
                          "descriptions only")
     language = model.language_encoder.encode_texts([input_text("repeat language", t) for t in texts])
@@ -140,4 +140,5 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
         for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
 
 
-__all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of", "execute_paraphrases"]
+__all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of",
+           "execute_paraphrases"]

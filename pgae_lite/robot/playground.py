@@ -35,29 +35,37 @@ import numpy as np
 import torch
 from matplotlib.figure import Figure
 
-from pgae_lite.world import patterns
+from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
-from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.robot.instructions import acted_on, check_route
-from pgae_lite.world.words import SIGNALS, VOCABULARY, WORD_INDEX, LanguageError, decode, is_correct, normalise_signal, \
-    parse_description, tokenize
-from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
-from pgae_lite.model.pgae import PGAE
-from pgae_lite.bert.pretrained import input_text
-from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
-from pgae_lite.sim.record import Execution
 from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
+from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
+from pgae_lite.robot.instructions import acted_on, check_route
+from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number, check_objects,
+                                                check_playground)
+from pgae_lite.robot.typed_text import read_typed
+from pgae_lite.sim.record import Execution
 from pgae_lite.util.checks import instance_of, positive_number, whole_number
-from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number,
-                                  check_objects, check_playground)
+from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.viz import animate_frames, plot_joints
+from pgae_lite.world import patterns
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
+from pgae_lite.world.words import (
+    SIGNALS,
+    VOCABULARY,
+    WORD_INDEX,
+    decode,
+    is_correct,
+    normalise_signal,
+)
 
 #: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
 PLAY_SIGNALS: tuple[str, ...] = ("describe", "execute", "repeat action", "repeat language")
-#: The 12 actions of an arrangement, (action, cube side, speed); action k is pattern 72·(k // 6) + 6·arrangement + k % 6.
+#: The 12 actions of an arrangement, (action, cube side, speed);
+#: action k is pattern 72·(k // 6) + 6·arrangement + k % 6.
 ACTIONS: tuple[tuple[str, str, str], ...] = tuple((a, side, speed) for speed in ("slowly", "fast")
                                                   for a, side in ACTION_SIDES)
 #: What the joints of each signal should be (the action decoder's target, from the recorded episode).
@@ -139,7 +147,8 @@ class PlayResult:
                  f"joints: nRMSE {self.nrmse:.2f}% against {TARGETS[self.signal]}; "
                  f"mean gate z {self.gate.mean():.2f} (0 = language, 1 = action)"]
         if self.understood is not None:
-            lines.insert(1, f"I understood: {self.understood or '<EOS>'} (the typed text said back with repeat language)")
+            said = self.understood or "<EOS>"
+            lines.insert(1, f"I understood: {said} (the typed text said back with repeat language)")
         if self.rollout is not None:
             verdict = "the cube moved as told" if self.rollout.passed else f"failed ({self.rollout.check.reason})"
             held = self.signal in ("describe", "repeat language")
@@ -189,21 +198,6 @@ class PlayResult:
         display(*self.displays(every))
 
 
-def _reader_text(model: PGAE, signal: str, text: str) -> tuple[str, ...] | None:
-    """The typed description's words (synonyms kept); None for free text PGAE-BERT may read."""
-    try:
-        parse_description(text)
-        return tuple(tokenize(text))
-    except LanguageError as e:
-        if not hasattr(model.language_encoder, "encode_texts"):
-            raise LanguageError(f"PGAE's LSTM reads only its vocabulary, in the order action colour speed "
-                                f"(PGAE-BERT reads free text): {e}") from None
-        if not LANG_IN[SIGNALS.index(signal)]:
-            raise LanguageError(f"{signal!r} reads no words, so text can only pick the episode, and that takes "
-                                f"a description: {e}") from None
-        return None
-
-
 @torch.no_grad()
 def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, data: PGAEDataset,
          signal: str = "execute", arrangement: int = 0, action: int = 0, text: str | None = None, *,
@@ -217,8 +211,9 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     only: :func:`~pgae_lite.robot.closedloop.closed_loop`, which needs ``cae``) or
     None (no simulation). ``config``: the simulated dataset's (default: found
     from ``data``). ``route``: free text under ``execute`` is executed ``"direct"``
-    or ``"said back"`` (its readback's words: :mod:`pgae_lite.robot.instructions`). Raises LanguageError or ValueError (a TypeError for a wrong type),
-    with a readable message, for a bad signal, text, choice or object.
+    or ``"said back"`` (its readback's words: :mod:`pgae_lite.robot.instructions`). Raises
+    LanguageError or ValueError (a TypeError for a wrong type), with a readable message, for a bad
+    signal, text, choice or object. A typed text is parsed once (:func:`~pgae_lite.robot.typed_text.read_typed`).
     """
     check_objects(model, cae, normaliser, data, config)
     pattern_number(arrangement, action)                    # checks both
@@ -230,8 +225,9 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     if loop == "closed" and (signal != "execute" or cae is None):
         raise ValueError("the closed loop runs the signal execute, with the CAE: the model writes each step's "
                          "joints from what its camera sees (choose execute, or the open loop)")
-    words = _reader_text(model, signal, text) if text else None
-    pattern = pattern_for(text, arrangement) if words else pattern_number(arrangement, action)
+    typed = read_typed(model.language_encoder, signal, text) if text else None   # parsed once, here
+    words = typed.words if typed else None
+    pattern = pattern_for(typed.meaning, arrangement) if words else pattern_number(arrangement, action)
     row, sim_variation = find_episode(data, pattern, variation)
     device = next(model.parameters()).device
     tensors = normaliser.tensors(data.subset([row]), device)
@@ -239,22 +235,23 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
         tensors["descriptions"][:] = torch.tensor([WORD_INDEX[w] for w in words], device=device)
     said = text or description_text(tensors["descriptions"][0, 0].cpu().numpy())   # the words the task may read
     reads_words = LANG_IN[SIGNALS.index(signal)]
-    lookup = getattr(model.language_encoder, "word_lookup", None)   # the variant: unknown words via WordNet
-    told = input_text(signal, (lookup.rewrite(said) if lookup and text else said) if reads_words else "")
-    free = bool(reads_words and text and words is None)   # PGAE-BERT reads the text as it is
-    language = model.language_encoder.encode_texts([told]) if free else None
+    told = input_text(signal, (typed.read if typed else said) if reads_words else "")   # as the model reads it
+    free = bool(reads_words and typed and typed.is_free)   # a pretrained encoder reads the text as it is
 
     model.eval()
     zero = torch.zeros(1, dtype=torch.long)
     understood = None
     if reads_words and text:                               # readback: the same words, said back, no action shown
-        back_language = model.language_encoder.encode_texts([input_text("repeat language", said)]) if free else None
+        back_language = typed.features("repeat language") if free else None
         back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
         understood = decode(back["logits"][0].argmax(-1).cpu())
+    language = None
     if free and route == "said back" and signal == "execute":   # act on its own words
         said = acted_on([understood], [said])[0]
         told = input_text(signal, said)
         language = model.language_encoder.encode_texts([told])
+    elif free:
+        language = typed.features(signal)                  # encoded once: also what the closed loop reads
     batch = make_batch(tensors, zero, signal_ids(signal, 1), zero)
     out = model(batch, language=language)
     length = int(data.lengths[row])

@@ -10,12 +10,12 @@ from __future__ import annotations
 from typing import Mapping
 
 from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
-from pgae_lite.evaluate import check_model_inputs
-from pgae_lite.world.words import normalise_signal
-from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, pattern_parts
 from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.evaluate import check_model_inputs
 from pgae_lite.util.checks import instance_of, shown, whole_number
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
+from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, pattern_parts
+from pgae_lite.world.words import normalise_signal
 
 SPEEDS = 2   # 0 slowly, 1 fast
 #: The last pattern number (143): speed, arrangement and action at their largest.

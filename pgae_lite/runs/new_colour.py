@@ -141,7 +141,7 @@ def load_pgae(path: str | Path, world: World, device: str | None = None
               ) -> tuple[PGAE, Normaliser, dict]:
     """Model (eval mode), normaliser and checkpoint of a PGAE trained for ``world``."""
     from pgae_lite.data.dataset import Normaliser
-    from pgae_lite.train.loop import CHECKPOINT, load_checkpoint
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 
     path = Path(path)
     ckpt = load_checkpoint(path / CHECKPOINT if path.is_dir() else path)

@@ -131,7 +131,8 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
     is training the same model into the cache (two chapters run side by side), this
     waits for it and then loads its model.
     """
-    from pgae_lite.train.loop import CHECKPOINT, DataMismatchError, train
+    from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError
+    from pgae_lite.train.loop import train
 
     training = as_training(training)
     base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
@@ -197,7 +198,7 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
 
 def _finished(training: Training, profile: Profile, seed: int) -> bool:
     """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
-    from pgae_lite.train.loop import CHECKPOINT, load_checkpoint
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 
     prof = training_profile(get_profile(profile, seed=seed), training)
     folder = _model_folder(prof, training.name)

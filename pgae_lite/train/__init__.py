@@ -1,5 +1,7 @@
 """Training PGAE (paper Sec. 3, "Loss Function", and Sec. 4, "Training Details").
 
-- ``config``  ``TrainConfig``, the training's settings, and the recipe version saved with every checkpoint
-- ``loop``    loss, the training loop, checkpoints, ``load_model``
+- ``config``      ``TrainConfig``, the training's settings, and the recipe version saved with every checkpoint
+- ``loss``        the loss (words and joints) and the optimiser's rate
+- ``checkpoint``  checkpoints: written atomically, read safely, checked against the data; ``load_model``
+- ``loop``        the training loop, as named steps
 """

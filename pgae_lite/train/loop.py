@@ -1,79 +1,67 @@
-"""Training PGAE: the loss, the loop, checkpoints (paper Sec. 3, "Loss Function", and Sec. 4).
+"""Training PGAE: the loop, as a short sequence of named steps (paper Sec. 3, "Loss Function", and Sec. 4).
 
-    L = α · weighted cross-entropy(words) + β · MSE(joints)
+    setup -> resume -> for each epoch, for each batch: batch -> language features -> step
+          -> record the epoch -> checkpoint
 
-The word weights counter word frequency (``<BOS/EOS>`` is in every
-description, a colour word in one of six); both terms are averaged over the
-valid steps only. Training is deterministic under a seed (bit for bit on the
-same kind of device: on the CPU it runs on a fixed number of torch threads,
-:func:`~pgae_lite.util.storage.training_threads`, since a 1-thread and a 2-thread run
-round sums differently and drift apart), runs on CUDA when present
-(else the CPU), and resumes from its last checkpoint after an interruption.
+Training is deterministic under a seed (bit for bit on the same kind of device: on the CPU it
+runs on a fixed number of torch threads, :func:`~pgae_lite.util.storage.training_threads`, since a
+1-thread and a 2-thread run round sums differently and drift apart), runs on CUDA when present
+(else the CPU), and resumes from its last checkpoint after an interruption
+(:mod:`pgae_lite.train.checkpoint`). The loss is :mod:`pgae_lite.train.loss`'s; a training on
+phrasings reads them from the bank the free-form code sets up
+(:func:`pgae_lite.bert.phrasing_bank.for_training`).
 """
 from __future__ import annotations
 
-import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
 import torch
 from torch import nn
 from tqdm.auto import tqdm
 
-from pgae_lite.config import Profile, get_profile
-from pgae_lite.train.config import saved_model_config
-from pgae_lite.data.dataset import JOINT_DIM, Normaliser, PGAEDataset
-from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.world.words import SIGNALS, word_weights
+from pgae_lite.bert.encoders import build_pgae
+from pgae_lite.bert.phrasing_bank import for_training
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.plan import plan_loss, plan_targets
-from pgae_lite.model.signals import EXECUTE, SignalBatch, make_batch, sample_signals
-from pgae_lite.util.storage import (CheckpointMismatchError, default_device, folder_lock, load_torch,
-                    save_torch, training_threads)
-
-CHECKPOINT = "checkpoint.pt"
-#: What every checkpoint written by :func:`save_checkpoint` holds.
-CHECKPOINT_KEYS = ("model", "optimiser", "generator", "torch_rng", "epoch", "history",
-                   "profile", "normaliser", "seconds")
+from pgae_lite.model.signals import EXECUTE, make_batch, sample_signals
+from pgae_lite.train.checkpoint import CHECKPOINT, check_trained_on, load_checkpoint, save_checkpoint, training_split
+from pgae_lite.train.loss import add_input_noise, lr_factor, parameter_groups, pgae_loss
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.storage import CheckpointMismatchError, default_device, folder_lock, training_threads
+from pgae_lite.world.words import SIGNALS, word_weights
 
 
-def pgae_loss(out: dict[str, torch.Tensor], batch: SignalBatch, weights: torch.Tensor,
-              alpha: float = 1.0, beta: float = 1.0) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-    """Total, language and action loss of one batch.
-
-    language = Σ w[y] · CE(logits, y) / Σ mask  over valid words
-    action   = Σ (ĵ − j)² / (5 · Σ mask)        over valid steps
-    """
-    ce = nn.functional.cross_entropy(out["logits"].transpose(1, 2), batch.lang_target,
-                                     reduction="none")                      # (B, 4)
-    m = batch.lang_mask.float()
-    lang = (weights[batch.lang_target] * ce * m).sum() / m.sum()
-    jm = batch.joint_mask.float()[..., None]                                # (B, T-1, 1)
-    act = ((out["joints"] - batch.joint_target) ** 2 * jm).sum() / (jm.sum() * out["joints"].shape[-1])
-    return alpha * lang + beta * act, lang, act
+class NonFiniteLossError(PGAELiteError, FloatingPointError):
+    """The training loss became NaN or infinite: the run stops, nothing is saved."""
 
 
-def lr_factor(step: int, total: int, warmup: float, schedule: str) -> float:
-    """Learning-rate multiplier: linear warm-up, then cosine decay to 0 (or constant)."""
-    warm = int(warmup * total)
-    if step < warm:
-        return (step + 1) / warm
-    if schedule == "constant":
-        return 1.0
-    progress = (step - warm) / max(1, total - warm)
-    return 0.5 * (1.0 + math.cos(math.pi * min(1.0, progress)))
+@dataclass
+class Trained:
+    """What :func:`train` returns: the model, its normaliser, the history and the wall time."""
+
+    model: PGAE
+    normaliser: Normaliser
+    history: list[dict]
+    profile: object          # the pgae_lite.config.Profile it was trained with
+    seconds: float
 
 
-def parameter_groups(model: nn.Module) -> list[dict]:
-    """The optimiser's groups: every weight at the recipe's rate, except those of a module with an
-    ``lr_scale`` (the tuned top layer, tuned_layer.py): lr · lr_scale, no weight decay."""
-    scaled = [m for m in model.modules() if hasattr(m, "lr_scale")]
-    own = {id(p) for m in scaled for p in m.parameters()}
-    groups = [{"params": [p for p in model.parameters() if id(p) not in own], "lr_scale": 1.0}]
-    groups += [{"params": list(m.parameters()), "lr_scale": m.lr_scale, "weight_decay": 0.0} for m in scaled]
-    return groups
+@dataclass
+class Run:
+    """What a training carries from step to step."""
+
+    model: PGAE
+    optimiser: torch.optim.Optimizer
+    gen: torch.Generator                 # signals, descriptions, views, shuffling
+    data: dict[str, torch.Tensor]        # the training samples, normalised, on the device
+    plans: torch.Tensor | None           # each sample's plan target (model/plan.py), if the model has a head
+    batches: int                         # per epoch
+    epoch: int = 0
+    history: list[dict] = field(default_factory=list)
+    elapsed: float = 0.0
 
 
 def batch_indices(lengths: torch.Tensor, batch_size: int, generator: torch.Generator,
@@ -92,47 +80,12 @@ def batch_indices(lengths: torch.Tensor, batch_size: int, generator: torch.Gener
     return [batches[i] for i in torch.randperm(len(batches), generator=generator)]
 
 
-@dataclass
-class Trained:
-    """What :func:`train` returns: the model, its normaliser, the history and the wall time."""
-
-    model: PGAE
-    normaliser: Normaliser
-    history: list[dict]
-    profile: Profile
-    seconds: float
-
-
-def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | None = None) -> torch.Tensor:
-    """``action_input`` (B, T, 30 + 5) plus Gaussian noise: ``std`` on the visual features, ``joint_std``
-    on the joints (``None``: ``std`` on both)."""
-    noise = torch.randn_like(action_input)
-    if joint_std is None:
-        return action_input + std * noise
-    scale = torch.full((action_input.shape[-1],), std, device=action_input.device)
-    scale[-JOINT_DIM:] = joint_std                                        # the last 5 channels are joints
-    return action_input + scale * noise
-
-
-class DataMismatchError(PGAELiteError, ValueError):
-    """A checkpoint is used with data (visual features) other than those it was trained on."""
-
-
-class NonFiniteLossError(PGAELiteError, FloatingPointError):
-    """The training loss became NaN or infinite: the run stops, nothing is saved."""
-
-
-def _training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
-    """The samples a training run learns from: the training split, or its first ``max_samples``."""
-    train_set = dataset.split("train")
-    return train_set.subset(slice(0, max_samples)) if max_samples else train_set
-
-
-def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: str | Path | None = None,
+def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
           device: torch.device | str | None = None, progress: bool = True,
           model: PGAE | None = None, callback=None) -> Trained:
-    """Train PGAE on the training split of ``dataset``.
+    """Train PGAE on the training split of ``dataset`` with ``profile``'s recipe.
 
+    ``profile``: a :class:`~pgae_lite.config.Profile` (``pgae_lite.config.get_profile(name)``).
     With ``out_dir`` a checkpoint is written there every
     ``checkpoint_every`` epochs and at the end (atomically); a later call with
     the same ``out_dir`` and profile resumes from it, and one whose training
@@ -142,6 +95,8 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
     (e.g. to evaluate along the way). A NaN or infinite loss stops the run
     (:class:`NonFiniteLossError`, naming the epoch and the batch).
     """
+    if not hasattr(profile, "to_dict") or not hasattr(profile, "train"):
+        raise TypeError(f"train takes a Profile, e.g. pgae_lite.config.get_profile('book'); got {profile!r}")
     device = torch.device(device) if device else default_device()
     args = (dataset, profile, out_dir, device, progress, model, callback)
     with training_threads(device):   # on the CPU a fixed thread count: the same model on any machine
@@ -151,113 +106,129 @@ def train(dataset: PGAEDataset, profile: Profile | str | None = None, out_dir: s
             return _train(*args)
 
 
-def _train(dataset: PGAEDataset, profile: Profile | str | None,
-           out_dir: str | Path | None, device: torch.device,
+def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: torch.device,
            progress: bool, model: PGAE | None, callback) -> Trained:
-    profile = profile if isinstance(profile, Profile) else get_profile(profile)
     cfg = profile.train
     cfg.__post_init__()              # checked again: a field may have been set since
-    train_set = _training_split(dataset, cfg.max_train_samples)
+    train_set = training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
-    data = normaliser.tensors(train_set, device)
+    run = _setup(train_set, normaliser, profile, device, model)
+    ckpt_path = Path(out_dir) / CHECKPOINT if out_dir else None
+    if ckpt_path and ckpt_path.exists():
+        _resume(run, ckpt_path, profile, normaliser, dataset.source)
+    weights = word_weights(getattr(run.model, "lexicon", None)).to(device)   # the model's words
+    t0 = time.perf_counter() - run.elapsed
+    bank = for_training(run.model.language_encoder, cfg)    # its encoding time counts as training time
+    bar = tqdm(range(run.epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
+               initial=run.epoch, total=cfg.epochs)
+    for epoch in bar:
+        record = _epoch(run, cfg, epoch, weights, bank, device)
+        bar.set_postfix(loss=f"{record['loss']:.4f}", lang=f"{record['language_loss']:.4f}",
+                        act=f"{record['action_loss']:.5f}")
+        if callback is not None:
+            callback(epoch + 1, run.model, record)
+            run.model.train()
+        if ckpt_path and (epoch + 1 == cfg.epochs or (epoch + 1) % cfg.checkpoint_every == 0):
+            save_checkpoint(ckpt_path, run.model, run.optimiser, run.gen, epoch + 1, run.history, profile,
+                            normaliser, time.perf_counter() - t0)
+    run.model.eval()
+    return Trained(run.model, normaliser, run.history, profile, time.perf_counter() - t0)
 
+
+def _setup(train_set: PGAEDataset, normaliser: Normaliser, profile, device: torch.device,
+           model: PGAE | None) -> Run:
+    """The model (seeded), its plan targets, the optimiser and the generator of a fresh run."""
+    cfg = profile.train
+    data = normaliser.tensors(train_set, device)
     torch.manual_seed(cfg.seed)
-    model = (model or PGAE(profile.model)).to(device)
-    plans = None                     # each training sample's plan target (plan.py), if the model has a plan head
+    model = (model or build_pgae(profile.model)).to(device)
+    plans = None
     if model.plan_head is not None and cfg.plan_weight:
         plans = plan_targets(data["joints"], data["lengths"], torch.as_tensor(train_set.pattern, device=device),
                              model.plan_head.keyframes)
-    # fused: one kernel for all parameters (measured: 0.55 ms per step against 3.2 ms; benchmarks/profile_epoch.py)
+    # fused: one kernel for all parameters (measured: benchmarks/profile_epoch.py, A2)
     fused = dict(fused=True) if device.type in ("cpu", "cuda") else {}
     groups = parameter_groups(model)
     optimiser = (torch.optim.AdamW(groups, lr=cfg.lr, weight_decay=cfg.weight_decay, **fused)
                  if cfg.weight_decay else torch.optim.Adam(groups, lr=cfg.lr, **fused))
-    gen = torch.Generator().manual_seed(cfg.seed)  # signals, descriptions, views, shuffling
-    n = len(train_set)
-    lengths = data["lengths"].cpu()
-    batches = len(batch_indices(lengths, cfg.batch_size, torch.Generator(), cfg.length_batches))
-    total = cfg.epochs * batches
-    start_epoch, history, elapsed = 0, [], 0.0
+    gen = torch.Generator().manual_seed(cfg.seed)
+    batches = len(batch_indices(data["lengths"].cpu(), cfg.batch_size, torch.Generator(), cfg.length_batches))
+    return Run(model, optimiser, gen, data, plans, batches)
 
-    ckpt_path = Path(out_dir) / CHECKPOINT if out_dir else None
-    if ckpt_path and ckpt_path.exists():
-        ckpt = load_checkpoint(ckpt_path)
-        if ckpt["profile"] != profile.to_dict():
-            raise CheckpointMismatchError(
-                f"{ckpt_path} was trained with a different profile or seed; use another output "
-                "folder, or delete the checkpoint to start again")
-        _check_trained_on(ckpt, normaliser.state_dict(), ckpt_path, dataset.source)
-        model.load_state_dict(ckpt["model"])
-        optimiser.load_state_dict(ckpt["optimiser"])
-        gen.set_state(ckpt["generator"])
-        torch.set_rng_state(ckpt["torch_rng"])
-        start_epoch, history, elapsed = ckpt["epoch"], ckpt["history"], ckpt["seconds"]
 
-    weights = word_weights(getattr(model, "lexicon", None)).to(device)   # model's words
-    t0 = time.perf_counter() - elapsed
-    bank = None                             # its encoding time counts as training time
-    if cfg.phrasings:                       # free-form language (phrasing_bank.py), PGAE-BERT only
-        from pgae_lite.bert.phrase_lexicon import training_lexicon
-        from pgae_lite.bert.phrasing_bank import PhrasingBank
-        bank = PhrasingBank(model.language_encoder, cfg.phrasings, cfg.seed, training_lexicon(cfg.phrasing_words),
-                            cfg.phrasing_signals, cfg.phrasing_prob)
-        if hasattr(model.language_encoder, "word_lookup"):   # words never trained on: WordNet first
-            from pgae_lite.bert.word_lookup import WordLookup
-            model.language_encoder.word_lookup = WordLookup(training_lexicon(cfg.phrasing_words), bank.texts)
-    bar = tqdm(range(start_epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
-               initial=start_epoch, total=cfg.epochs)
-    for epoch in bar:
-        model.train()
-        epoch_batches = batch_indices(lengths, cfg.batch_size, gen, cfg.length_batches)
-        sums = torch.zeros(3)
-        gate_sum, gate_n = torch.zeros(len(SIGNALS)), torch.zeros(len(SIGNALS))
-        for b in range(batches):
-            step = epoch * batches + b
-            for g in optimiser.param_groups:
-                g["lr"] = cfg.lr * lr_factor(step, total, cfg.warmup, cfg.schedule) * g.get("lr_scale", 1.0)
-            index = epoch_batches[b]
-            size = len(index)
-            signal = sample_signals(size, gen, cfg.signals_per_sample, cfg.signal_probs)
-            alternative = torch.randint(8, (size,), generator=gen)
-            opposite = torch.rand(size, generator=gen) < cfg.opposite_prob
-            opposite &= signal != EXECUTE  # execute shows no action to the encoder
-            batch = make_batch(data, index, signal, alternative, opposite)
-            if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
-                batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
-            language = None if bank is None else bank.features(model, batch, gen, step)
-            out = model(batch, teacher_language=cfg.teacher_language,
-                        feedback="greedy" if cfg.teacher_language else "soft", language=language)
-            loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)
-            if plans is not None:      # Deviation from paper: L += β γ L_plan (plan.py)
-                planned = plan_loss(out["plan"], plans[index.to(device)], batch.signal)
-                loss = loss + cfg.action_weight * cfg.plan_weight * planned
-            optimiser.zero_grad(set_to_none=True)
-            loss.backward()
-            if cfg.clip:
-                nn.utils.clip_grad_norm_(model.parameters(), cfg.clip)
-            optimiser.step()
-            losses = torch.tensor([loss.item(), lang.item(), act.item()])
-            if not torch.isfinite(losses).all():
-                _stop(losses, epoch, b, batches, signal)
-            sums += losses * size
-            z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
-            gate_sum.index_add_(0, signal, z)
-            gate_n.index_add_(0, signal, torch.ones(size))
-        loss, lang, act = (sums / n).tolist()
-        gates = (gate_sum / gate_n.clamp(min=1)).tolist()
-        history.append({"epoch": epoch + 1, "loss": loss, "language_loss": lang, "action_loss": act,
-                        "lr": optimiser.param_groups[0]["lr"],
+def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) -> None:
+    """Continue from the checkpoint at ``path``: the same recipe and data, or a clear error."""
+    ckpt = load_checkpoint(path)
+    if ckpt["profile"] != profile.to_dict():
+        raise CheckpointMismatchError(
+            f"{path} was trained with a different profile or seed; use another output "
+            "folder, or delete the checkpoint to start again")
+    check_trained_on(ckpt, normaliser.state_dict(), path, source)
+    run.model.load_state_dict(ckpt["model"])
+    run.optimiser.load_state_dict(ckpt["optimiser"])
+    run.gen.set_state(ckpt["generator"])
+    torch.set_rng_state(ckpt["torch_rng"])
+    run.epoch, run.history, run.elapsed = ckpt["epoch"], ckpt["history"], ckpt["seconds"]
+
+
+def _epoch(run: Run, cfg, epoch: int, weights: torch.Tensor, bank, device: torch.device) -> dict:
+    """One epoch: every batch a step; returns (and keeps in the history) the epoch's record."""
+    run.model.train()
+    lengths = run.data["lengths"].cpu()
+    epoch_batches = batch_indices(lengths, cfg.batch_size, run.gen, cfg.length_batches)
+    total = cfg.epochs * run.batches
+    sums = torch.zeros(3)
+    gate_sum, gate_n = torch.zeros(len(SIGNALS)), torch.zeros(len(SIGNALS))
+    for b in range(run.batches):
+        step = epoch * run.batches + b
+        for g in run.optimiser.param_groups:
+            g["lr"] = cfg.lr * lr_factor(step, total, cfg.warmup, cfg.schedule) * g.get("lr_scale", 1.0)
+        index = epoch_batches[b]
+        batch = _batch(run, cfg, index)
+        language = None if bank is None else bank.features(run.model, batch, run.gen, step)
+        out, losses = _step(run, cfg, batch, index, language, weights, device)
+        if not torch.isfinite(losses).all():
+            _stop(losses, epoch, b, run.batches, batch.signal)
+        sums += losses * len(index)
+        z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
+        gate_sum.index_add_(0, batch.signal, z)
+        gate_n.index_add_(0, batch.signal, torch.ones(len(index)))
+    loss, lang, act = (sums / len(lengths)).tolist()
+    gates = (gate_sum / gate_n.clamp(min=1)).tolist()
+    run.history.append({"epoch": epoch + 1, "loss": loss, "language_loss": lang, "action_loss": act,
+                        "lr": run.optimiser.param_groups[0]["lr"],
                         "gate": {s: g for s, g, k in zip(SIGNALS, gates, gate_n) if k > 0}})
-        bar.set_postfix(loss=f"{loss:.4f}", lang=f"{lang:.4f}", act=f"{act:.5f}")
-        if callback is not None:
-            callback(epoch + 1, model, history[-1])
-            model.train()
-        last = epoch + 1 == cfg.epochs
-        if ckpt_path and (last or (epoch + 1) % cfg.checkpoint_every == 0):
-            save_checkpoint(ckpt_path, model, optimiser, gen, epoch + 1, history, profile, normaliser,
-                            time.perf_counter() - t0)
-    model.eval()
-    return Trained(model, normaliser, history, profile, time.perf_counter() - t0)
+    return run.history[-1]
+
+
+def _batch(run: Run, cfg, index: torch.Tensor):
+    """The batch of samples ``index``: a signal each, a description, a view, the input noise."""
+    size = len(index)
+    signal = sample_signals(size, run.gen, cfg.signals_per_sample, cfg.signal_probs)
+    alternative = torch.randint(8, (size,), generator=run.gen)
+    opposite = torch.rand(size, generator=run.gen) < cfg.opposite_prob
+    opposite &= signal != EXECUTE  # execute shows no action to the encoder
+    batch = make_batch(run.data, index, signal, alternative, opposite)
+    if cfg.input_noise or cfg.joint_input_noise:  # regularises what the action encoder reads (model units)
+        batch.action_input = add_input_noise(batch.action_input, cfg.input_noise, cfg.joint_input_noise)
+    return batch
+
+
+def _step(run: Run, cfg, batch, index: torch.Tensor, language: torch.Tensor | None, weights: torch.Tensor,
+          device: torch.device) -> tuple[dict, torch.Tensor]:
+    """One optimiser step on a batch: its outputs and its (total, language, action) loss."""
+    out = run.model(batch, teacher_language=cfg.teacher_language,
+                    feedback="greedy" if cfg.teacher_language else "soft", language=language)
+    loss, lang, act = pgae_loss(out, batch, weights, cfg.language_weight, cfg.action_weight)
+    if run.plans is not None:      # Deviation from paper: L += β γ L_plan (model/plan.py)
+        planned = plan_loss(out["plan"], run.plans[index.to(device)], batch.signal)
+        loss = loss + cfg.action_weight * cfg.plan_weight * planned
+    run.optimiser.zero_grad(set_to_none=True)
+    loss.backward()
+    if cfg.clip:
+        nn.utils.clip_grad_norm_(run.model.parameters(), cfg.clip)
+    run.optimiser.step()
+    return out, torch.tensor([loss.item(), lang.item(), act.item()])
 
 
 def _stop(losses: torch.Tensor, epoch: int, batch: int, batches: int,
@@ -271,72 +242,4 @@ def _stop(losses: torch.Tensor, epoch: int, batch: int, batches: int,
         "for extreme values in the data, or lower the learning rate")
 
 
-def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, gen: torch.Generator,
-                    epoch: int, history: list[dict], profile: Profile, normaliser: Normaliser,
-                    seconds: float) -> None:
-    """Write a checkpoint atomically (a crash mid-write never leaves a broken file).
-
-    A write that fails (a full disk, a read-only folder) raises
-    :class:`~pgae_lite.util.storage.OutputError` naming the file; the old checkpoint stays.
-    """
-    save_torch({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
-                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(),
-                "epoch": epoch, "history": history, "profile": profile.to_dict(),
-                "normaliser": normaliser.state_dict(), "seconds": seconds}, path)
-
-
-def load_checkpoint(path: str | Path) -> dict:
-    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only).
-
-    An empty, truncated or foreign file raises
-    :class:`~pgae_lite.util.storage.CorruptCheckpointError` naming it.
-    """
-    return load_torch(path, CHECKPOINT_KEYS)
-
-
-def _same_numbers(a: list, b: list) -> bool:
-    """Two (nested) lists of floats hold the same numbers, up to rounding."""
-    a, b = (np.hstack([np.ravel(x) for x in v]).astype(float) for v in (a, b))
-    return a.shape == b.shape and bool(np.allclose(a, b))
-
-
-def _check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "") -> None:
-    """Raise :class:`DataMismatchError` unless ``fitted`` (a normaliser's state, fitted on the
-    training samples of the data at hand) equals the one saved in ``ckpt``."""
-    saved = ckpt["normaliser"]
-    differ = [k for k in saved if k not in fitted or not _same_numbers(fitted[k], saved[k])]
-    if differ:
-        raise DataMismatchError(
-            f"{path} was not trained on this data ({source or 'dataset'}): the statistics of its training "
-            f"samples ({', '.join(differ)}) differ from those saved with the model. Use the data it was "
-            "trained on: for our simulated data the same cache (PGAE_LITE_CACHE), since the visual features "
-            "come from the cache's CAE and a CAE trained elsewhere (or with another number of threads) gives "
-            "other features; or train the model again on this data (another output folder).")
-
-
-def load_model(path: str | Path, device: torch.device | str | None = None,
-               dataset: PGAEDataset | None = None) -> tuple[PGAE, Normaliser, dict]:
-    """Model (in eval mode), normaliser and the checkpoint's other contents.
-
-    With ``dataset``, first check that the model was trained on it: the
-    normaliser fitted on its training samples must equal the one saved. The
-    visual features come from a CAE, and two CAEs (e.g. trained with another
-    number of threads, in another cache) give different features: a model fed
-    another CAE's features produces nonsense without any error, so this
-    raises :class:`DataMismatchError` instead.
-    """
-    ckpt = load_torch(path, ("model", "profile", "normaliser"))
-    if dataset is not None:
-        cfg = ckpt["profile"]["train"]
-        fitted = Normaliser.fit(_training_split(dataset, cfg.get("max_train_samples")),
-                                cfg.get("vision_scaling", "global")).state_dict()
-        _check_trained_on(ckpt, fitted, path, dataset.source)
-    model = PGAE(saved_model_config(ckpt["profile"], path))
-    model.load_state_dict(ckpt["model"])
-    model.to(device or default_device()).eval()
-    return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
-
-
-__all__ = ["train", "pgae_loss", "DataMismatchError", "NonFiniteLossError",
-           "Trained", "load_model", "load_checkpoint",
-           "save_checkpoint", "lr_factor"]
+__all__ = ["NonFiniteLossError", "Run", "Trained", "batch_indices", "train"]

@@ -1,0 +1,105 @@
+"""Checkpoints of a training: written atomically, read safely, checked against the data (paper Sec. 4).
+
+A checkpoint holds the model's weights (with whatever its language encoder keeps beside them,
+e.g. the free-form variant's word lookup), the optimiser, the random generators, the history,
+the recipe (``Profile.to_dict()``, with its version) and the normaliser fitted on the training
+samples: :func:`load_model` rebuilds the same model from it, and refuses data it was not trained on.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from pgae_lite.bert.encoders import build_pgae
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.train.config import saved_model_config
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.storage import default_device, load_torch, save_torch
+
+CHECKPOINT = "checkpoint.pt"
+#: What every checkpoint written by :func:`save_checkpoint` holds.
+CHECKPOINT_KEYS = ("model", "optimiser", "generator", "torch_rng", "epoch", "history",
+                   "profile", "normaliser", "seconds")
+
+
+class DataMismatchError(PGAELiteError, ValueError):
+    """A checkpoint is used with data (visual features) other than those it was trained on."""
+
+
+def training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAEDataset:
+    """The samples a training run learns from: the training split, or its first ``max_samples``."""
+    train_set = dataset.split("train")
+    return train_set.subset(slice(0, max_samples)) if max_samples else train_set
+
+
+def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, gen: torch.Generator,
+                    epoch: int, history: list[dict], profile, normaliser: Normaliser,
+                    seconds: float) -> None:
+    """Write a checkpoint atomically (a crash mid-write never leaves a broken file).
+
+    A write that fails (a full disk, a read-only folder) raises
+    :class:`~pgae_lite.util.storage.OutputError` naming the file; the old checkpoint stays.
+    """
+    save_torch({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
+                "generator": gen.get_state(), "torch_rng": torch.get_rng_state(),
+                "epoch": epoch, "history": history, "profile": profile.to_dict(),
+                "normaliser": normaliser.state_dict(), "seconds": seconds}, path)
+
+
+def load_checkpoint(path: str | Path) -> dict:
+    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only).
+
+    An empty, truncated or foreign file raises
+    :class:`~pgae_lite.util.storage.CorruptCheckpointError` naming it.
+    """
+    return load_torch(path, CHECKPOINT_KEYS)
+
+
+def _same_numbers(a: list, b: list) -> bool:
+    """Two (nested) lists of floats hold the same numbers, up to rounding."""
+    a, b = (np.hstack([np.ravel(x) for x in v]).astype(float) for v in (a, b))
+    return a.shape == b.shape and bool(np.allclose(a, b))
+
+
+def check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "") -> None:
+    """Raise :class:`DataMismatchError` unless ``fitted`` (a normaliser's state, fitted on the
+    training samples of the data at hand) equals the one saved in ``ckpt``."""
+    saved = ckpt["normaliser"]
+    differ = [k for k in saved if k not in fitted or not _same_numbers(fitted[k], saved[k])]
+    if differ:
+        raise DataMismatchError(
+            f"{path} was not trained on this data ({source or 'dataset'}): the statistics of its training "
+            f"samples ({', '.join(differ)}) differ from those saved with the model. Use the data it was "
+            "trained on: for our simulated data the same cache (PGAE_LITE_CACHE), since the visual features "
+            "come from the cache's CAE and a CAE trained elsewhere (or with another number of threads) gives "
+            "other features; or train the model again on this data (another output folder).")
+
+
+def load_model(path: str | Path, device: torch.device | str | None = None,
+               dataset: PGAEDataset | None = None) -> tuple[PGAE, Normaliser, dict]:
+    """Model (in eval mode), normaliser and the checkpoint's other contents.
+
+    With ``dataset``, first check that the model was trained on it: the
+    normaliser fitted on its training samples must equal the one saved. The
+    visual features come from a CAE, and two CAEs (e.g. trained with another
+    number of threads, in another cache) give different features: a model fed
+    another CAE's features produces nonsense without any error, so this
+    raises :class:`DataMismatchError` instead.
+    """
+    ckpt = load_torch(path, ("model", "profile", "normaliser"))
+    if dataset is not None:
+        cfg = ckpt["profile"]["train"]
+        fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
+                                cfg.get("vision_scaling", "global")).state_dict()
+        check_trained_on(ckpt, fitted, path, dataset.source)
+    model = build_pgae(saved_model_config(ckpt["profile"], path))
+    model.load_state_dict(ckpt["model"])
+    model.to(device or default_device()).eval()
+    return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
+
+
+__all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "load_checkpoint", "load_model",
+           "save_checkpoint", "training_split"]
