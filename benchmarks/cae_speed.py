@@ -1,7 +1,7 @@
 """Speed (and, with --train, quality) of the channel-separated CAE on a CPU or GPU.
 
     python benchmarks/cae_speed.py [--batches 16 32 200] [--seconds 8] [--threads 1]
-    python benchmarks/cae_speed.py --train [--profile book] [--data sim --episodes 48] [--threads 2]
+    python benchmarks/cae_speed.py --train [--profile book] [--frames sim --episodes 48] [--threads 2]
 
 Without --train it times training steps (forward, BCE, backward, Adam) of a
 CAE of the default architecture at each batch size, and feature extraction
@@ -114,11 +114,11 @@ def time_extraction(model, x, seconds) -> float:
 
 
 def trained_row(args, seed: int, device: torch.device) -> dict:
-    """Train the profile's CAE (seeded ``seed``) on ``--data`` frames; its time and reconstruction quality."""
+    """Train the profile's CAE (seeded ``seed``) on ``--frames`` frames; its time and reconstruction quality."""
     config = replace(get_profile(args.profile).cae, seed=seed,
                      **({"iterations": args.iterations} if args.iterations else {}))
-    data = frames(args.data, args.episodes, args.stride, seed=0)
-    test = frames(args.data, max(2, args.episodes // 8), 4, seed=1)
+    data = frames(args.frames, args.episodes, args.stride, seed=0)
+    test = frames(args.frames, max(2, args.episodes // 8), 4, seed=1)
     t0 = time.perf_counter()
     model, history = train_cae(data, config, device=device, progress=False)
     seconds = time.perf_counter() - t0
@@ -159,7 +159,7 @@ def main() -> None:
     bench.parser.add_argument("--seconds", type=float, default=8.0, help="time budget per measurement")
     bench.parser.add_argument("--train", action="store_true", help="train the profile's CAE end to end")
     bench.parser.add_argument("--iterations", type=int, help="with --train: override the profile's iterations")
-    bench.parser.add_argument("--data", choices=["synthetic", "sim"], default="synthetic",
+    bench.parser.add_argument("--frames", choices=["synthetic", "sim"], default="synthetic",
                               help="with --train: the frames")
     bench.parser.add_argument("--episodes", type=int, default=48, help="with --train: episodes of frames")
     bench.parser.add_argument("--stride", type=int, default=4, help="with --train: every k-th frame of those episodes")
@@ -173,7 +173,7 @@ def main() -> None:
         rows.append(trained_row(args, seed, device) if args.train else speed_row(args, seed, device))
         print(rows[-1], flush=True)
     bench.write({"mode": "train" if args.train else "steps", "device": str(device), "load_average": load,
-                 **({"data": args.data, "episodes": args.episodes, "stride": args.stride} if args.train
+                 **({"data": args.frames, "episodes": args.episodes, "stride": args.stride} if args.train
                     else {"batches": args.batches}), "rows": rows})
 
 

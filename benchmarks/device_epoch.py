@@ -1,6 +1,6 @@
 """Seconds per training epoch on each device: the paper's batch (6) against the book recipe's.
 
-    python benchmarks/device_epoch.py [--data PATH] [--profile paper] [--epochs 3]
+    python benchmarks/device_epoch.py [--original-data PATH] [--profile paper] [--epochs 3]
                                       [--batches 6 16] [--devices cpu cuda] [--threads 2]
 
 Trains the PGAE row on the authors' data with :func:`pgae_lite.train.loop.train`, unchanged, for
@@ -33,7 +33,7 @@ def epoch_seconds(dataset, profile, device: str) -> list[float]:
 def main() -> None:
     bench = Benchmark("device_epoch", __doc__)
     bench.parser.set_defaults(profile="paper")
-    bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+    bench.add_original_data()
     bench.parser.add_argument("--epochs", type=int, default=3, help="epochs per training (>= 2)")
     bench.parser.add_argument("--batches", type=int, nargs="+",
                               default=[6, get_profile("book").train.batch_size])
@@ -43,7 +43,7 @@ def main() -> None:
     if args.epochs < 2:
         bench.parser.error(f"--epochs must be at least 2 (the first is warm-up), got {args.epochs}")
     devices = args.devices or ["cpu"] + (["cuda"] if torch.cuda.is_available() else [])
-    dataset = load_original(args.data)
+    dataset = load_original(args.original_data)
     rows = []
     for device in devices:
         for batch in args.batches:

@@ -1,7 +1,7 @@
 """Seconds per training epoch of the recipe and of candidate changes to it, timed in one run.
 
     python benchmarks/epoch_time.py --candidates time_stride=3 units=80,time_stride=3 batch_size=24
-                                    [--data PATH] [--epochs 3] [--rounds 2] [--threads 1]
+                                    [--original-data PATH] [--epochs 3] [--rounds 2] [--threads 1]
 
 On the authors' data (648 training samples), with the real training loop
 (:func:`pgae_lite.train.loop.train`). A candidate is one or more options of the
@@ -51,14 +51,14 @@ def epoch_seconds(dataset, profile_name: str, changes: dict, epochs: int) -> lis
 
 def main() -> None:
     bench = Benchmark("epoch_time", __doc__)
-    bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+    bench.add_original_data()
     bench.parser.add_argument("--candidates", nargs="+", type=candidate, required=True, metavar="KEY=VALUE[,...]")
     bench.parser.add_argument("--epochs", type=int, default=3, help="epochs per training, the first not counted")
     bench.parser.add_argument("--rounds", type=int, default=2, help="times every setting is trained, in turn")
     args = bench.parse()
     if args.epochs < 2 or args.rounds < 1:
         bench.parser.error("--epochs must be at least 2 (the first warms up) and --rounds at least 1")
-    dataset = load_original(args.data)
+    dataset = load_original(args.original_data)
     settings = [{}] + args.candidates                               # the recipe first
     seconds = [[] for _ in settings]
     for _ in range(args.rounds):

@@ -2,7 +2,7 @@
 
     python benchmarks/free_language.py [--trainings PGAE-BERT PGAE-BERT-phrasings] [--seeds 0]
                                        [--profile book] [--threads 1] [--no-closed] [--workers 2]
-    python benchmarks/free_language.py --original ../shared/pgae-original-data
+    python benchmarks/free_language.py --original-data ../shared/pgae-original-data
                                        [--trainings PGAE-BERT-phrasings] [--seeds 0 1 2] [--workers 2]
 
 Both models are trained (or loaded from the cache) on the profile's simulated
@@ -33,7 +33,7 @@ is measured with ``PGAE-BERT-phrasings-held-out``, trained without the words of
 :func:`pgae_lite.bert.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
 Writes results/free_language.json.
 
-With ``--original`` it measures only the canonical Table 1 of each training on
+With ``--original-data`` it measures only the canonical Table 1 of each training on
 the authors' data (runs resumable under benchmarks/out/), into
 results/free_language-original.json.
 
@@ -99,7 +99,7 @@ def original_run(training: str, seed: int, profile_name: str, path: str) -> dict
 def original_table1(bench: Benchmark, args) -> None:
     """Each training's canonical Table 1 on the authors' data (e.g. for the variant, next to the paper's row)."""
     bench.name = "free_language-original"
-    jobs = [(training, seed, args.profile, args.original) for training in args.trainings for seed in args.seeds]
+    jobs = [(training, seed, args.profile, args.original_data) for training in args.trainings for seed in args.seeds]
     bench.write({"data": "authors'", "runs": side_by_side(original_run, jobs, args.workers)})
 
 
@@ -116,7 +116,7 @@ def training_time(bench: Benchmark, args) -> None:
             with tempfile.TemporaryDirectory() as empty:
                 os.environ[CACHE_ENV] = empty     # nothing cached: the encoding is timed too
                 t0 = time.perf_counter()
-                trained = train(data, profile, progress=False)
+                train(data, profile, progress=False)
                 seconds = time.perf_counter() - t0
             runs.append({"training": training, "seed": seed, "seconds": round(seconds, 1),
                          "epochs": profile.train.epochs})
@@ -179,10 +179,10 @@ def main() -> None:
     bench.parser.add_argument("--no-closed", action="store_true", help="open loop only (fast)")
     bench.parser.add_argument("--workers", type=int, default=1,
                               help="models measured side by side, each in its own process on one thread")
-    bench.parser.add_argument("--original", default=None, help="the authors' data: canonical Table 1 only")
+    bench.add_original_data(None, "the authors' data: each training's canonical Table 1 there, and nothing else")
     bench.parser.add_argument("--time", action="store_true", help="the variant's training time against PGAE-BERT's")
     args = bench.parse()
-    if args.original:
+    if args.original_data:
         return original_table1(bench, args)
     if args.time:
         return training_time(bench, args)

@@ -45,6 +45,7 @@ from multiprocessing import get_context
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+DEFAULT_ORIGINAL_DATA = "../shared/pgae-original-data"
 RESULTS = ROOT / "results"
 
 
@@ -96,6 +97,18 @@ class Benchmark:
         self.parser.add_argument("--profile", default="book", help="the recipe's profile (default: book)")
         self.parser.add_argument("--seeds", type=int, nargs="+", default=seeds or [0], help="seeds to run")
         self.args: argparse.Namespace | None = None
+
+    def add_original_data(self, default: str | None = DEFAULT_ORIGINAL_DATA,
+                          help: str = "the authors' data folder (holding target/ and vocabulary.txt)") -> None:
+        """``--original-data PATH``, spelled as ``python -m pgae_lite reproduce`` spells it, in every script."""
+        shown = f"default: $PGAE_ORIGINAL_DATA, else {default}" if default else "default: none"
+        self.parser.add_argument("--original-data", metavar="PATH", help=f"{help} ({shown})",
+                                 default=os.environ.get("PGAE_ORIGINAL_DATA", default) if default else None)
+
+    def add_workers(self, default: int = 1, what: str = "runs") -> None:
+        """``--workers N``: how many ``what`` run at once on this machine (one spelling in every script)."""
+        self.parser.add_argument("--workers", type=int, default=default,
+                                 help=f"{what} at once, in processes of their own (default {default})")
 
     def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
         self.args = self.parser.parse_args(argv)

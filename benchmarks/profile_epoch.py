@@ -1,6 +1,6 @@
 """Where one epoch of PGAE training spends its time, and how close it runs to the machine's peak.
 
-    python benchmarks/profile_epoch.py [--data PATH] [--batches 6 16] [--epochs 2] [--threads 2]
+    python benchmarks/profile_epoch.py [--original-data PATH] [--batches 6 16] [--epochs 2] [--threads 2]
 
 On the authors' data (648 training samples; our simulated data has the same
 shapes), with the book recipe's model and training options, for each batch
@@ -39,20 +39,20 @@ from pgae_lite.model.signals import ACTION_IN, LANG_IN, SIGNAL_PROBS
 from pgae_lite.train.loop import train
 
 bench = Benchmark("profile_epoch", __doc__)
-bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+bench.add_original_data()
 bench.parser.add_argument("--batches", type=int, nargs="+", default=None,
                           help="batch sizes (default: the paper's 6 and the recipe's)")
 bench.parser.add_argument("--epochs", type=int, default=2, help="timed epochs per setting")
 args = bench.parse()
 recipe = get_profile(args.profile)
 batches = args.batches or sorted({6, recipe.train.batch_size})
-dataset = load_original(args.data)
+dataset = load_original(args.original_data)
 train_set = dataset.split("train")
 
 
 def lstm_flops(inputs: int, units: int, layers: int, steps: float) -> float:
     """Forward FLOP of one sample through a stacked LSTM: 2 · 4H · (I + H) per layer and step."""
-    return 2 * 4 * units * sum((inputs if l == 0 else units) + units for l in range(layers)) * steps
+    return 2 * 4 * units * sum((inputs if layer == 0 else units) + units for layer in range(layers)) * steps
 
 
 def epoch_flops(model_units: int = 100, layers: int = 2, hidden: int = 50, stride: int = 1) -> float:
@@ -131,5 +131,6 @@ for batch in batches:
         print(f"batch {batch:3d} {'bf16' if bf16 else 'fp32'}: {seconds:.3f} s/epoch, "
               f"{row['samples_per_second']:.0f} samples/s, {row['gflops']:.0f} GFLOP/s "
               f"({row['share_of_float32_peak_%']:.0f}% of the float32 peak); time: {row['share_%']}")
-bench.write({"time_stride": model_cfg.time_stride, "epoch_gflop": round(flops / 1e9, 2), "peak_gflops": {k: round(v, 1) for k, v in peaks.items()},
+bench.write({"time_stride": model_cfg.time_stride, "epoch_gflop": round(flops / 1e9, 2),
+             "peak_gflops": {k: round(v, 1) for k, v in peaks.items()},
              "training_samples": len(train_set), "rows": rows})

@@ -1,6 +1,6 @@
 """Wall time of one training + evaluation: the book recipe against the one it replaced, side by side.
 
-    python benchmarks/recipe_time.py [--data PATH] [--threads 2] [--seeds 0]
+    python benchmarks/recipe_time.py [--original-data PATH] [--threads 2] [--seeds 0]
 
 On the authors' data, one after the other in this one process (the machines
 are shared and noisy: both are timed side by side, on the same data, under
@@ -29,9 +29,9 @@ PREVIOUS = {"epochs": 1200, "batch_size": 64, "lr": 2e-3, "action_weight": 2.0, 
 PREVIOUS_MODEL = {"time_stride": 1, "gmu_norm": False, "plan_keyframes": 0}
 
 bench = Benchmark("recipe_time", __doc__)
-bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+bench.add_original_data()
 args = bench.parse()
-dataset = load_original(args.data)
+dataset = load_original(args.original_data)
 
 rows = []
 for seed in args.seeds:

@@ -27,8 +27,7 @@ from harness import ROOT, Benchmark
 bench = Benchmark("same_behaviour", __doc__)
 bench.parser.add_argument("--base", required=True, help="the commit to compare HEAD with")
 bench.parser.add_argument("--rows", default="all", help="Table 1's rows, as reproduce takes them")
-bench.parser.add_argument("--original-data", default=os.environ.get("PGAE_ORIGINAL_DATA",
-                                                                    "../shared/pgae-original-data"))
+bench.add_original_data()
 
 
 def git(*args: str) -> str:

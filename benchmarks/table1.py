@@ -1,14 +1,14 @@
 """Table 1 over several seeds: every row asked for, each cell's median, mean and std.
 
-    python benchmarks/table1.py [--sim | --data PATH] [--rows PGAE,PGAE-BERT] [--seeds 0 1 2]
-                                [--profile book] [--jobs 1] [--threads 2]
+    python benchmarks/table1.py [--sim | --original-data PATH] [--rows PGAE,PGAE-BERT] [--seeds 0 1 2]
+                                [--profile book] [--workers 1] [--threads 2]
 
 Each seed runs ``python -m pgae_lite reproduce`` in its own process and
 output folder under benchmarks/out/ (so an interrupted benchmark resumes, and
-a finished seed is read, not run again). ``--jobs 2 --threads 1`` runs two
+a finished seed is read, not run again). ``--workers 2 --threads 1`` runs two
 seeds at once, one core each: more throughput on a 2-core machine, but each
 run's wall time is then not that of a run alone; measure that with
-``--jobs 1 --threads 2``. Writes results/table1-original.json (or
+``--workers 1 --threads 2``. Writes results/table1-original.json (or
 table1-sim.json): every seed's cells, their median, mean and std, the paper's,
 and whether each median is at or better than the paper's.
 """
@@ -28,10 +28,10 @@ from pgae_lite.runs.reproduce import parse_rows
 from harness import Benchmark
 
 bench = Benchmark("table1", __doc__, seeds=[0, 1, 2])
-bench.parser.add_argument("--data", default=os.environ.get("PGAE_ORIGINAL_DATA", "../shared/pgae-original-data"))
+bench.add_original_data()
 bench.parser.add_argument("--sim", action="store_true", help="our simulated data instead of the authors'")
 bench.parser.add_argument("--rows", default="PGAE")
-bench.parser.add_argument("--jobs", type=int, default=1)
+bench.add_workers(1, "seeds")
 bench.parser.add_argument("--runs", default="benchmarks/out", help="the runs' output folders (resumable)")
 args = bench.parse()
 source = "sim" if args.sim else "original"
@@ -44,14 +44,14 @@ def run(seed: int) -> dict:
     out = Path(args.runs) / f"table1-{source}-{args.profile}-{'+'.join(rows)}-seed{seed}"
     if not (out / "results.json").exists():
         env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-        data = [] if args.sim else ["--original-data", args.data]
+        data = [] if args.sim else ["--original-data", args.original_data]
         subprocess.run([sys.executable, "-m", "pgae_lite", "reproduce", *data, "--rows", ",".join(rows),
                         "--profile", args.profile, "--seed", str(seed), "--out", str(out), "--no-progress",
                         "--device", "cpu"], check=True, env=env, stdout=subprocess.DEVNULL)
     return json.loads((out / "results.json").read_text())
 
 
-with ThreadPoolExecutor(args.jobs) as pool:
+with ThreadPoolExecutor(args.workers) as pool:
     reports = list(pool.map(run, args.seeds))
 
 summary, lines = {}, []
@@ -83,4 +83,4 @@ for row in rows:
                                                   for s in TEST_SIGNALS))
     lines.append("median at or better than the paper: " + json.dumps(verdict))
 print("\n".join(lines))
-bench.write({"data": source, "rows": summary, "jobs": args.jobs, "threads_per_run": threads})
+bench.write({"data": source, "rows": summary, "workers": args.workers, "threads_per_run": threads})

@@ -1,6 +1,6 @@
 """Training throughput of PGAE on the authors' data: samples per second and seconds per epoch.
 
-    python benchmarks/throughput.py [--data PATH] [--batches 6 64] [--cells lstm peephole]
+    python benchmarks/throughput.py [--original-data PATH] [--batches 6 64] [--cells lstm peephole]
                                     [--feedback own start] [--seconds 10] [--profile book] [--threads 2]
 
 For each cell and batch size it times full training steps (signals drawn per
@@ -53,14 +53,14 @@ def seconds_per_step(model: PGAE, tensors: dict, samples: int, batch: int, seed:
 
 def main() -> None:
     bench = Benchmark("throughput", __doc__)
-    bench.parser.add_argument("--data", default="../shared/pgae-original-data")
+    bench.add_original_data()
     bench.parser.add_argument("--batches", type=int, nargs="+", default=[6, 64])
     bench.parser.add_argument("--cells", nargs="+", default=["lstm", "peephole"])
     bench.parser.add_argument("--feedback", nargs="+", default=["own", "start"], choices=["own", "start"])
     bench.parser.add_argument("--seconds", type=float, default=10.0, help="time budget per measurement")
     args = bench.parse()
 
-    data = load_original(args.data).split("train")
+    data = load_original(args.original_data).split("train")
     tensors = Normaliser.fit(data).tensors(data)
     model_config = get_profile(args.profile).model
     rows = []

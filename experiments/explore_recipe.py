@@ -6,7 +6,9 @@ On the authors' data by default; ``--sim`` uses the book profile's simulated dat
 ``--opposite`` also scores the opposite agent's view (PGAE-opposite; cells prefixed ``opp_``),
 for the two-view model (``--set opposite_prob=0.5``).
 """
-import argparse, json, time
+import argparse
+import json
+import time
 from pathlib import Path
 
 import torch
@@ -25,7 +27,8 @@ def overrides(pairs):
 
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--data", default="../shared/pgae-original-data")
+    ap.add_argument("--original-data", metavar="PATH", default="../shared/pgae-original-data",
+                    help="the authors' data folder")
     ap.add_argument("--epochs", type=int, default=300)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--every", type=int, default=25)
@@ -41,7 +44,7 @@ def main() -> None:
 
     prof = get_profile("book", epochs=a.epochs, seed=a.seed, **overrides(a.set))
     prof.model = replace(prof.model, **overrides(a.model))
-    ds = simulated_dataset("book", progress=False) if a.sim else load_original(a.data)
+    ds = simulated_dataset("book", progress=False) if a.sim else load_original(a.original_data)
     t0 = time.perf_counter()
     rows = []
 
@@ -53,7 +56,8 @@ def main() -> None:
         norm = Normaliser.fit(ds.split("train"), prof.train.vision_scaling)
         res, _ = evaluate(model, ds, norm)
         line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},
-                **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()}, "loss": round(rec["loss"], 4),
+                **{k.replace(" ", "_")[:9] + "_e": round(v["nrmse"], 3) for k, v in res.items()},
+                "loss": round(rec["loss"], 4),
                 "gate": {k: round(v, 2) for k, v in rec["gate"].items()}}
         if a.opposite:
             opp, _ = evaluate(model, ds, norm, opposite=True)

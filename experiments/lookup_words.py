@@ -17,6 +17,7 @@ the test paraphrases (``pgae_lite/paraphrases.tsv``) are left out of both
 settings, so that the rule is chosen on words the test never says; the test
 is read only to leave them out.
 """
+import argparse
 from collections import Counter
 
 from pgae_lite.world.words import VOCABULARY
@@ -24,6 +25,7 @@ from pgae_lite.bert.paraphrases import load_paraphrases
 from pgae_lite.bert.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
 from pgae_lite.bert.word_lookup import WordLookup
 
+argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()   # no options: --help only
 test_words = {w for p in load_paraphrases() for w in words_of(p.text)}
 dataset_words = {w for word in VOCABULARY for w in words_of(word)}
 meaning = {p: m for slot in SLOTS for m, phrases in LEXICON.phrases(slot).items() for p in phrases}

@@ -1,6 +1,7 @@
 """The most any read-out of the frozen transformer gets from the paraphrases: trained probes.
 
-    python experiments/paraphrase_readout.py [--model NAME] [--carriers 20] [--out experiments/out/paraphrase_readout.json]
+    python experiments/paraphrase_readout.py [--model NAME] [--carriers 20]
+                                             [--out experiments/out/paraphrase_readout.json]
 
 PGAE-BERT reads a sentence only through the frozen transformer. Here small
 classifiers are trained on the transformer's outputs for the sentences

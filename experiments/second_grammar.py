@@ -18,9 +18,9 @@ never used in training.
 """
 from __future__ import annotations
 
+import argparse
 import random
 import re
-import sys
 
 from pgae_lite.bert.phrase_lexicon import LEXICON, MEANINGS, SLOTS
 from pgae_lite.bert.phrasings import gerund
@@ -99,5 +99,10 @@ def second_phrasings(action: str, colour: str, speed: str, n: int, seed: int = 0
 
 
 if __name__ == "__main__":
-    action, colour, speed, n = sys.argv[1:5]
-    print("\n".join(second_phrasings(action, colour, speed, int(n))))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("action", help="push, pull or slide")
+    parser.add_argument("colour", help="one of the six cube colours, e.g. red")
+    parser.add_argument("speed", help="slowly or fast")
+    parser.add_argument("n", type=int, help="how many distinct sentences")
+    args = parser.parse_args()
+    print("\n".join(second_phrasings(args.action, args.colour, args.speed, args.n)))

@@ -149,26 +149,27 @@ def test_gmu_passes_module_class_instance_and_function():
     assert check_gmu(gmu_forward)
 
 
-def gmu_variant(h_of, z_of=torch.sigmoid, gate_input=lambda a, l: torch.cat([a, l], 1), squash=torch.tanh):
-    def forward(gmu, a, l):
-        a_h, l_h = squash(gmu.action_linear(a)), squash(gmu.language_linear(l))
-        z = z_of(gmu.gate_linear(gate_input(a, l)))
+def gmu_variant(h_of, z_of=torch.sigmoid, gate_input=lambda a, lang: torch.cat([a, lang], 1), squash=torch.tanh):
+    def forward(gmu, a, lang):
+        a_h, l_h = squash(gmu.action_linear(a)), squash(gmu.language_linear(lang))
+        z = z_of(gmu.gate_linear(gate_input(a, lang)))
         return h_of(z, a_h, l_h), z
     return forward
 
 
-REFERENCE_H = lambda z, a, l: z * a + (1 - z) * l  # noqa: E731
+REFERENCE_H = lambda z, a, lang: z * a + (1 - z) * lang  # noqa: E731
 
 
 @pytest.mark.parametrize("student, phrases", [
-    (gmu_variant(lambda z, a, l: z * l + (1 - z) * a), ["z should weight the ACTION features: h = z*A_h + (1-z)*L_h"]),
-    (gmu_variant(REFERENCE_H, gate_input=lambda a, l: torch.cat([l, a], 1)), ["action features first"]),
+    (gmu_variant(lambda z, a, lang: z * lang + (1 - z) * a),
+     ["z should weight the ACTION features: h = z*A_h + (1-z)*L_h"]),
+    (gmu_variant(REFERENCE_H, gate_input=lambda a, lang: torch.cat([lang, a], 1)), ["action features first"]),
     (gmu_variant(REFERENCE_H, squash=lambda t: t), ["need a tanh"]),
     (gmu_variant(REFERENCE_H, z_of=lambda t: t), ["z needs a sigmoid"]),
-    (gmu_variant(lambda z, a, l: z * a + l), ["(1 - z)"]),
-    (lambda gmu, a, l: gmu_forward(gmu, a, l)[::-1], ["return (z, h)"]),
-    (lambda gmu, a, l: gmu_forward(gmu, a, l)[0], ["pair (h, z)"]),
-    (lambda gmu, a, l: (gmu_forward(gmu, a, l)[0][:, :1], gmu_forward(gmu, a, l)[1]), ["h has shape (6, 1)"]),
+    (gmu_variant(lambda z, a, lang: z * a + lang), ["(1 - z)"]),
+    (lambda gmu, a, lang: gmu_forward(gmu, a, lang)[::-1], ["return (z, h)"]),
+    (lambda gmu, a, lang: gmu_forward(gmu, a, lang)[0], ["pair (h, z)"]),
+    (lambda gmu, a, lang: (gmu_forward(gmu, a, lang)[0][:, :1], gmu_forward(gmu, a, lang)[1]), ["h has shape (6, 1)"]),
 ])
 def test_gmu_names_the_mistake(student, phrases):
     result = check_gmu(student)
@@ -177,9 +178,9 @@ def test_gmu_names_the_mistake(student, phrases):
 
 def test_gmu_module_with_other_layer_names_is_told_the_names():
     class Renamed(nn.Module):
-        def __init__(self, a, l, h):
+        def __init__(self, a, lang, h):
             super().__init__()
-            self.wa, self.wl, self.wz = nn.Linear(a, h), nn.Linear(l, h), nn.Linear(a + l, h)
+            self.wa, self.wl, self.wz = nn.Linear(a, h), nn.Linear(lang, h), nn.Linear(a + lang, h)
     assert failed_with(check_gmu(Renamed), "cannot copy the reference weights", "action_linear.weight")
     assert failed_with(check_gmu(type("NoArgs", (nn.Module,), {})), "NoArgs(7, 5, 4) raised TypeError")
 
@@ -203,7 +204,7 @@ def test_bottleneck_passes_concatenation_and_the_gmu(cell):
     assert result and "backward pass done" in str(result)
     assert "yours 40,050, the GMU's 80,150" in str(result)
     assert check_bottleneck(GatedMultimodalUnit, cell=cell)
-    assert check_bottleneck(lambda a, l, h: ConcatBottleneck(a, l, h))
+    assert check_bottleneck(lambda a, lang, h: ConcatBottleneck(a, lang, h))
 
 
 class TwiceTheAction(ConcatBottleneck):
@@ -246,8 +247,8 @@ class NotANumber(ConcatBottleneck):
     (Detached, ["no gradient reaches the action_encoder", ".detach()"]),
     (Unused, ["no gradient reaches your parameter(s) ['gate.weight', 'gate.bias']"]),
     (NotANumber, ["the loss is nan"]),
-    (lambda a, l, h: nn.Linear(a + l, h), ["raised TypeError", "takes both"]),
-    (lambda a, l, h: "concat", ["returned a str", "nn.Module"]),
+    (lambda a, lang, h: nn.Linear(a + lang, h), ["raised TypeError", "takes both"]),
+    (lambda a, lang, h: "concat", ["returned a str", "nn.Module"]),
 ])
 def test_bottleneck_names_the_mistake(factory, phrases):
     result = check_bottleneck(factory)

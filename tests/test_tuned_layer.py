@@ -108,7 +108,8 @@ def test_training_tunes_saves_and_reloads_the_layer(toy_short, tmp_path):
     torch.testing.assert_close(saved["model"]["language_encoder.top.key.weight"], layer.key.weight.detach())
     again, _, _ = load_model(tmp_path / "checkpoint.pt", device="cpu")
     trained.model.eval()
-    torch.testing.assert_close(again.language_encoder.encode_texts(TEXTS), trained.model.language_encoder.encode_texts(TEXTS))
+    torch.testing.assert_close(again.language_encoder.encode_texts(TEXTS),
+                               trained.model.language_encoder.encode_texts(TEXTS))
 
 
 def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path, interrupt_training):

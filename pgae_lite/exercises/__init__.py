@@ -1,8 +1,9 @@
 """Check functions for the book's exercises: your version against the package's.
 
 Each check runs a student's code next to the reference on seeded random inputs and returns a
-:class:`~pgae_lite.exercises.result.CheckResult`: a short report (what matched; where and by how much it did not, with a hint
-tied to the paper's equation), truthy only when everything matched (``assert check_gmu(MyGMU)``).
+:class:`~pgae_lite.exercises.result.CheckResult`: a short report (what matched; where and by how
+much it did not, with a hint tied to the paper's equation), truthy only when everything matched
+(``assert check_gmu(MyGMU)``).
 A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacement, the signals;
 Sec. 4: the vocabulary, and our simulator's cube colours.
 
@@ -14,7 +15,8 @@ Sec. 4: the vocabulary, and our simulator's cube colours.
 
 Every check is importable from here, e.g. ``from pgae_lite.exercises import check_gmu``.
 """
-from pgae_lite.exercises.model import check_bottleneck, check_gmu, check_lstm_step, check_peephole_step, check_signal_probs
+from pgae_lite.exercises.model import (check_bottleneck, check_gmu, check_lstm_step, check_peephole_step,
+                                      check_signal_probs)
 from pgae_lite.exercises.result import CheckResult
 from pgae_lite.exercises.world import check_colour, check_new_colour, check_vocabulary
 

@@ -275,7 +275,8 @@ def check_signal_probs(probs: Sequence[float] | dict[str, float], drop: str | No
     else:
         result.note(f"the authors' ratios, renormalised, would be {[round(a, 4) for a in authors]}")
     drawn = sample_signals(9000, torch.Generator().manual_seed(0), probs=tuple(p)).bincount(minlength=5) / 9000
-    result.note("share of 9000 draws, as training draws them: " + ", ".join(f"{s} {f:.3f}" for s, f in zip(SIGNALS, drawn)))
+    shares = ", ".join(f"{s} {f:.3f}" for s, f in zip(SIGNALS, drawn))
+    result.note(f"share of 9000 draws, as training draws them: {shares}")
     return result
 
 

@@ -82,7 +82,8 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
         result.fail(f"the values must lie in [0, 1]; got {tuple(values)}",
                     "pybullet takes 0..1: divide 0..255 values by 255" if max(values) > 1 else None)
     if len(values) != 4:
-        result.fail(f"an RGBA colour has 4 numbers; got {len(values)}", "add the alpha, 1.0" if len(values) == 3 else None)
+        result.fail(f"an RGBA colour has 4 numbers; got {len(values)}",
+                    "add the alpha, 1.0" if len(values) == 3 else None)
     elif values[3] != 1.0:
         result.fail(f"alpha is {values[3]}; the cubes are opaque (alpha 1.0)")
     if not result:
@@ -95,7 +96,8 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
         result.fail(f"too close to {closest}: no colour channel differs by more than {gaps[closest]:.2f}",
                     f"the CAE sees R, G and B separately: make one channel differ by {min_difference} or more")
     else:
-        result.ok(f"a valid opaque RGBA; the nearest is {closest}, {gaps[closest]:.2f} apart in the most different channel")
+        result.ok(f"a valid opaque RGBA; the nearest is {closest}, "
+                  f"{gaps[closest]:.2f} apart in the most different channel")
     return result
 
 
