@@ -108,3 +108,43 @@ def test_every_ablation_a_chapter_quotes_is_in_its_result_file():
     assert calls, "no chapter quotes the ablations"
     for ablation, name in calls:
         results.ablation_frame(ablation, name or "ablations")      # KeyError/FileNotFoundError if not
+
+
+def test_the_repository_is_found_by_argument_variable_or_working_directory(tmp_path, monkeypatch):
+    monkeypatch.delenv(results.REPOSITORY_ENV, raising=False)
+    monkeypatch.delenv(results.RESULTS_ENV, raising=False)
+    assert results.repository(ROOT) == ROOT                                   # an explicit argument
+    monkeypatch.chdir(ROOT / "notebooks")                                     # where a chapter runs
+    assert results.repository() == ROOT and results.results_dir() == ROOT / "results"
+    monkeypatch.chdir(tmp_path)                                               # outside any repository
+    with pytest.raises(results.RepositoryNotFoundError, match=f"at or above {tmp_path}.*set PGAE_LITE_REPOSITORY"):
+        results.repository()
+    monkeypatch.setenv(results.REPOSITORY_ENV, str(ROOT))                     # the variable
+    assert results.repository() == ROOT and "table1-original" in results.names()
+    with pytest.raises(results.RepositoryNotFoundError, match="root = .* holds no results/ folder"):
+        results.repository(tmp_path)
+
+
+def test_superseded_result_files_are_read_from_the_history_folder(monkeypatch):
+    monkeypatch.delenv(results.RESULTS_ENV, raising=False)
+    monkeypatch.chdir(ROOT)
+    history = [n for n in results.names() if n.startswith("history/")]
+    assert "history/fast-250x16-table1-original" in history
+    assert results.measured(history[0]).startswith("measured ")
+
+
+def test_the_readme_is_rewritten_in_a_repository_given_by_root(tmp_path):
+    import shutil
+    import subprocess
+    import sys
+
+    (tmp_path / "results").mkdir()
+    shutil.copy(ROOT / "results" / "table1-original.json", tmp_path / "results")
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    start, end = readme.index(results.README_START), readme.index(results.README_END)
+    (tmp_path / "README.md").write_text(readme[:start] + results.README_START + " old -->\nstale\n" + readme[end:])
+    done = subprocess.run([sys.executable, "-m", "pgae_lite.runs.results", "--readme", "--root", str(tmp_path)],
+                          cwd=tmp_path, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    written = (tmp_path / "README.md").read_text(encoding="utf-8")
+    assert "stale" not in written and results.headline_table() in written

@@ -13,6 +13,11 @@ from its measurement. A result file is written by one of the scripts in
     >>> value("recipe_time", "recipes", "fast", "minutes")       # a figure
     >>> quote("recipe_time", "recipes", "fast", "minutes", digits=1)   # the same, as text
     >>> measured("recipe_time")                                   # when, where and how
+
+The files are found in the repository (:func:`repository`: an explicit ``root``, else
+``$PGAE_LITE_REPOSITORY``, else the first folder at or above the working directory that holds
+``results/`` and ``_toc.yml``), never beside the package's source, which an installed package
+does not have. Superseded files lie in ``results/history/`` and are named ``history/NAME``.
 """
 from __future__ import annotations
 
@@ -22,19 +27,48 @@ from pathlib import Path
 
 import pandas as pd
 
+from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.storage import atomic_write_text
 from pgae_lite.world.words import TEST_SIGNALS
 
-RESULTS_ENV = "PGAE_LITE_RESULTS"
+RESULTS_ENV = "PGAE_LITE_RESULTS"          # a results folder alone (tests)
+REPOSITORY_ENV = "PGAE_LITE_REPOSITORY"    # the repository's root
 
 
-def results_dir() -> Path:
-    """``$PGAE_LITE_RESULTS``, else the repository's ``results/`` (beside the package)."""
-    return Path(os.environ.get(RESULTS_ENV) or Path(__file__).resolve().parents[2] / "results")
+class RepositoryNotFoundError(PGAELiteError, FileNotFoundError):
+    """No repository (a folder holding ``results/`` and ``_toc.yml``) where it was looked for."""
+
+
+def repository(root: str | Path | None = None) -> Path:
+    """The repository's root: ``root``, else ``$PGAE_LITE_REPOSITORY``, else the first folder at or
+    above the working directory that holds ``results/`` and ``_toc.yml``."""
+    given = root if root is not None else os.environ.get(REPOSITORY_ENV)
+    if given:
+        path = Path(given).expanduser()
+        if not (path / "results").is_dir():
+            where = "root" if root is not None else f"${REPOSITORY_ENV}"
+            raise RepositoryNotFoundError(f"{where} = {str(given)!r} holds no results/ folder; give the "
+                                          "pgae_lite repository's root (the folder of README.md and results/)")
+        return path
+    here = Path.cwd().resolve()
+    for folder in (here, *here.parents):
+        if (folder / "results").is_dir() and (folder / "_toc.yml").is_file():
+            return folder
+    raise RepositoryNotFoundError(f"no pgae_lite repository (a folder with results/ and _toc.yml) at or above "
+                                  f"{here}; run from inside the repository, or set {REPOSITORY_ENV} to its root")
+
+
+def results_dir(root: str | Path | None = None) -> Path:
+    """``$PGAE_LITE_RESULTS``, else the repository's ``results/`` (:func:`repository`)."""
+    return Path(os.environ.get(RESULTS_ENV) or repository(root) / "results")
 
 
 def names() -> list[str]:
-    """The result files there, by name (``table1-original`` for ``results/table1-original.json``)."""
-    return sorted(p.stem for p in results_dir().glob("*.json"))
+    """The result files there, by name (``table1-original`` for ``results/table1-original.json``;
+    ``history/NAME`` for a superseded one in ``results/history/``)."""
+    folder = results_dir()
+    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.glob("*.json")) + \
+        sorted(f"history/{p.stem}" for p in (folder / "history").glob("*.json"))
 
 
 def load(name: str) -> dict:
@@ -187,10 +221,16 @@ def readme_with_headline(readme: str) -> str:
 
 
 if __name__ == "__main__":
-    import sys
+    import argparse
 
-    if sys.argv[1:] != ["--readme"]:
-        raise SystemExit("usage: python -m pgae_lite.runs.results --readme   (rewrites README.md's headline table)")
-    readme = Path(__file__).resolve().parents[2] / "README.md"
-    readme.write_text(readme_with_headline(readme.read_text()))
+    parser = argparse.ArgumentParser(prog="python -m pgae_lite.runs.results",
+                                     description="Rewrite README.md's headline table from the result file.")
+    parser.add_argument("--readme", action="store_true", required=True, help="rewrite the README's headline table")
+    parser.add_argument("--root", default=None, help=f"the repository (default: ${REPOSITORY_ENV}, else the "
+                                                     "folder at or above here with results/ and _toc.yml)")
+    args = parser.parse_args()
+    root = repository(args.root)
+    os.environ[REPOSITORY_ENV] = str(root)          # every file below is read from this repository
+    readme = root / "README.md"
+    atomic_write_text(readme, readme_with_headline(readme.read_text(encoding="utf-8")))   # never left half-written
     print(f"{readme}: headline table rewritten from {results_dir() / 'table1-original.json'}")
