@@ -21,7 +21,6 @@ import functools
 from dataclasses import replace
 
 import torch
-from torch import nn
 
 from harness import Benchmark, side_by_side
 from pgae_lite.world import words as language
@@ -29,22 +28,11 @@ from pgae_lite.config import get_profile
 from pgae_lite.evaluate import evaluate
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.model.layers import ConcatBottleneck
 from pgae_lite.train.loop import train
 
 #: ex-pgae-no-both: the signals without "repeat both" (describe, execute, repeat action, -, repeat language)
 NO_BOTH = (3 / 8, 3 / 8, 1 / 8, 0.0, 1 / 8)
-
-
-class ConcatBottleneck(nn.Module):
-    """ex-pgae-concat: h = tanh(W [f_action; f_language] + b) in place of the GMU (a constant gate)."""
-
-    def __init__(self, action_dim: int, language_dim: int, hidden_dim: int = 50):
-        super().__init__()
-        self.linear = nn.Linear(action_dim + language_dim, hidden_dim)
-
-    def forward(self, f_action, f_language):
-        h = torch.tanh(self.linear(torch.cat([f_action, f_language], dim=1)))
-        return h, torch.full_like(h, 0.5)
 
 
 def concat_model(profile):

@@ -8,6 +8,7 @@ import pytest
 import torch
 from torch import nn
 
+from pgae_lite.model.layers import ConcatBottleneck   # the reference answer of the concatenation exercise
 from pgae_lite.config import get_profile
 from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu, check_lstm_step,
                                  check_peephole_step, check_signal_probs, check_vocabulary)
@@ -186,18 +187,6 @@ def test_gmu_module_with_other_layer_names_is_told_the_names():
 
 
 # ------------------------------------------------------------------ (c) a bottleneck in PGAE
-class ConcatBottleneck(nn.Module):
-    """The reference solution of the concatenation exercise (chapter 4)."""
-
-    def __init__(self, action_dim, language_dim, hidden_dim=50):
-        super().__init__()
-        self.linear = nn.Linear(action_dim + language_dim, hidden_dim)
-
-    def forward(self, f_action, f_language):
-        h = torch.tanh(self.linear(torch.cat([f_action, f_language], dim=1)))
-        return h, torch.full_like(h, 0.5)
-
-
 @pytest.mark.parametrize("cell", ["lstm", "peephole"])
 def test_bottleneck_passes_concatenation_and_the_gmu(cell):
     result = check_bottleneck(ConcatBottleneck, cell=cell)

@@ -210,3 +210,21 @@ class GatedMultimodalUnit(nn.Module):
         z = torch.sigmoid(self.gate_linear(torch.cat([f_action, f_language], dim=1)))  # z = σ(W_z [f_act; f_lang] + b)
         h = z * a_h + (1 - z) * l_h                              # h = z ⊙ A_h + (1 − z) ⊙ L_h
         return h, z
+
+
+class ConcatBottleneck(nn.Module):
+    """The GMU's ablation (not in the paper): h = tanh(W [f_act; f_lang] + b), no gate.
+
+    The reference answer of the book's concatenation exercises (chapters 04, 05, A1) and the
+    ``concat`` row of ``benchmarks/ablations.py``. It returns a constant gate of 0.5, so that
+    every plot of z still works.
+    """
+
+    def __init__(self, action_dim: int, language_dim: int, hidden_dim: int = 50):
+        super().__init__()
+        self.linear = nn.Linear(action_dim + language_dim, hidden_dim)
+
+    def forward(self, f_action: torch.Tensor, f_language: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        h = torch.tanh(self.linear(torch.cat([f_action, f_language], dim=1)))    # (B, hidden)
+        return h, torch.full_like(h, 0.5)
+
