@@ -1,19 +1,24 @@
 """The same numbers before and after a change of the code's shape: two commits side by side.
 
-    python benchmarks/same_behaviour.py --base REV [--profile smoke] [--rows all] [--seeds 0]
-                                        [--original-data PATH]
+    python benchmarks/same_behaviour.py --base REV [--head REV] [--reuse] [--profile smoke] [--rows all]
+                                        [--seeds 0] [--original-data PATH]
 
-Each commit (``--base`` and the checkout's HEAD) is checked out into a temporary
-worktree and runs ``python -m pgae_lite reproduce`` on the authors' data with a
-cache of its own (nothing shared, so each side trains every model itself), one
-thread, the same seed. Then every trained model's weights are compared tensor by
-tensor (``torch.equal``), every Table 1 cell of ``results.json`` number by number,
-and every array of ``predictions.npz``. Writes results/same_behaviour-PROFILE.json:
-per training, whether its weights are bit-identical; per cell, both values; and
-the counts of what differs (0 everywhere when the change kept the behaviour).
+Each commit (``--base``, and ``--head``: the checkout's HEAD by default) is checked
+out into a temporary worktree and runs ``python -m pgae_lite reproduce`` on the
+authors' data with a cache of its own (nothing shared, so each side trains every
+model itself), one thread, the same seed. With ``--reuse`` the head side starts
+from a copy of the base side's output folder instead: it trains nothing and
+evaluates the base's trained models (a code change that needs no retraining).
+Then every model's weights are compared tensor by tensor (``torch.equal``), every
+Table 1 cell of ``results.json`` number by number, and every array of
+``predictions.npz``. Writes results/same_behaviour-PROFILE.json (with ``--reuse``,
+same_behaviour-PROFILE-reused.json): per training, whether its weights are
+bit-identical; per cell, both values; the counts of what differs (0 everywhere
+when the change kept the behaviour).
 """
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -26,6 +31,8 @@ from harness import ROOT, Benchmark
 
 bench = Benchmark("same_behaviour", __doc__)
 bench.parser.add_argument("--base", required=True, help="the commit to compare HEAD with")
+bench.parser.add_argument("--head", default="HEAD", help="the commit compared with the base (default: HEAD)")
+bench.parser.add_argument("--reuse", action="store_true", help="the head evaluates the base's trained models")
 bench.parser.add_argument("--rows", default="all", help="Table 1's rows, as reproduce takes them")
 bench.add_original_data()
 
@@ -34,9 +41,11 @@ def git(*args: str) -> str:
     return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
 
 
-def run(rev: str, work: Path, args) -> Path:
-    """``reproduce`` at commit ``rev`` in a worktree of its own; its output folder."""
+def run(rev: str, work: Path, args, start: Path | None = None) -> Path:
+    """``reproduce`` at commit ``rev`` in a worktree of its own; its output folder (a copy of ``start``)."""
     tree, out = work / f"tree-{rev}", work / f"out-{rev}"
+    if start is not None:
+        shutil.copytree(start, out)
     git("worktree", "add", "--detach", str(tree), rev)
     try:
         env = {**os.environ, "PYTHONPATH": str(tree), "PGAE_LITE_CACHE": str(work / f"cache-{rev}"),
@@ -79,9 +88,10 @@ def compare(base: Path, head: Path) -> dict:
 
 if __name__ == "__main__":
     args = bench.parse()
-    bench.name = f"same_behaviour-{args.profile}"
-    base, head = git("rev-parse", "--short", args.base), git("rev-parse", "--short", "HEAD")
+    bench.name = f"same_behaviour-{args.profile}" + ("-reused" if args.reuse else "")
+    base, head = git("rev-parse", "--short", args.base), git("rev-parse", "--short", args.head)
     with tempfile.TemporaryDirectory() as work:
-        result = compare(run(base, Path(work), args), run(head, Path(work), args))
+        before = run(base, Path(work), args)
+        result = compare(before, run(head, Path(work), args, start=before if args.reuse else None))
     print(json.dumps(result["differ"]), flush=True)
-    bench.write({"base": base, "head": head, "rows": args.rows, **result})
+    bench.write({"base": base, "head": head, "reused": args.reuse, "rows": args.rows, **result})
