@@ -1,0 +1,8 @@
+"""Runs: the cached pipeline from simulator to trained models, Table 1 over seeds, the results files.
+
+- ``pipeline``    simulator -> CAE -> features -> trained models, each step cached
+- ``trainings``   trainings that are not Table 1's rows: PGAE-no-plan, the free-form variants
+- ``new_colour``  the same pipeline for a world with a new colour (appendix A3)
+- ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
+- ``results``     the committed result files, read and quoted by the book and the README
+"""
