@@ -20,7 +20,7 @@ free text, any text outside the 869, reads the transformer's top layer trained
 (:mod:`pgae_lite.bert.tuned_layer`) before the pooling. A training on phrasings gives
 the encoder a ``word_lookup`` (:mod:`pgae_lite.bert.word_lookup`): free text's words
 that training never held are first looked up in WordNet. Used by the free-form
-variant ``PGAE-BERT-phrasings`` (:data:`pgae_lite.config.TRAININGS`), never by the
+variant ``PGAE-BERT-phrasings`` (:data:`pgae_lite.runs.trainings.PHRASINGS`), never by the
 paper's PGAE-BERT.
 """
 from __future__ import annotations

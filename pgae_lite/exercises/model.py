@@ -237,7 +237,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
 def check_signal_probs(probs: Sequence[float] | dict[str, float], drop: str | None = "repeat both") -> CheckResult:
     """(e) Training probabilities of the signals with ``drop`` left out: a list in the order of
     :data:`~pgae_lite.world.words.SIGNALS`, or a dict by signal name (missing names count as 0).
-    Train with them as ``get_profile(..., signal_probs=probs)`` (:class:`~pgae_lite.config.TrainConfig`)."""
+    Train with them as ``get_profile(..., signal_probs=probs)`` (:class:`~pgae_lite.train.config.TrainConfig`)."""
     result = CheckResult(f"signal probabilities without {drop!r}" if drop else "signal probabilities")
     if drop is not None and drop not in SIGNALS:
         return result.fail(f"drop is {drop!r}; expected None or one of the signals: "

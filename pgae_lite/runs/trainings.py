@@ -21,11 +21,14 @@ from __future__ import annotations
 
 from pgae_lite.config import TRAININGS, Training
 
+#: The book recipe without its plan head (chapters 04 and 07).
 NO_PLAN = Training("PGAE-no-plan", model={"plan_keyframes": 0})
 
 _FREE_FORM_MODEL = {"language_encoder": "pretrained-attention", "tuned_top_layer": True}
+#: The free-form variant (chapters 05 and 08; not in the paper).
 PHRASINGS = Training("PGAE-BERT-phrasings", model=_FREE_FORM_MODEL,
                      train={"phrasings": 60, "phrasing_signals": ("repeat language",)})
+#: The free-form variant trained without the held-out words (``benchmarks/free_language.py``).
 PHRASINGS_HELD_OUT = Training("PGAE-BERT-phrasings-held-out", model=_FREE_FORM_MODEL,
                               train={**PHRASINGS.train, "phrasing_words": "held-out"})
 

@@ -114,8 +114,9 @@ class TrainConfig:
 
 
 def saved_model_config(recipe: dict, path) -> ModelConfig:
-    """The :class:`ModelConfig` of a checkpoint's saved recipe (``Profile.to_dict()``), if it was
-    trained with this :data:`RECIPE_VERSION`; else a :class:`CheckpointMismatchError` that says so."""
+    """The :class:`~pgae_lite.model.config.ModelConfig` of a checkpoint's saved recipe
+    (``Profile.to_dict()``), if it was trained with this :data:`RECIPE_VERSION`; else a
+    :class:`~pgae_lite.util.storage.CheckpointMismatchError` that says so."""
     version = recipe.get("recipe_version") if isinstance(recipe, dict) else None
     if version != RECIPE_VERSION:
         raise CheckpointMismatchError(
