@@ -23,6 +23,8 @@ CACHE_ENV = "PGAE_LITE_CACHE"
 
 # Tiny models run no faster on two threads, and much slower when another job shares the cores.
 torch.set_num_threads(1)
+# The tests read this repository's results/ wherever pytest is started from (pgae_lite.runs.results).
+os.environ.setdefault("PGAE_LITE_REPOSITORY", str(Path(__file__).resolve().parents[1]))
 DEFAULT_ORIGINAL_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "pgae-original-data"
 
 
