@@ -62,7 +62,11 @@ can could may might must shall should will would ought need dare
 not too very just also only even still now again
 one ones once first second next last other another such let get got make made please yes ok okay
 """.split())
-_WORD = re.compile(r"[A-Za-z']+")
+# A word: letters of any script, with inner apostrophes ("don't", "fåst"); digits, "_" and other marks split words.
+_WORD = re.compile(r"[^\W\d_]+(?:'[^\W\d_]+)*")
+# What may be looked up: a plain English word of three letters or more. A single letter or a pair ("s l o w",
+# "o.k.") and a word in another script are never read as anything else: they are kept as they are.
+_LOOKABLE = re.compile(r"[a-z]{3,}")
 
 
 def _phrase(text: str) -> str:
@@ -167,7 +171,8 @@ class WordLookup:
         for word in _WORD.findall(text):
             if word not in self._read_as:                   # each word decided once (morphology, senses)
                 low = word.lower()
-                self._read_as[word] = None if self.is_known(low) else self.target(low)
+                unknown = _LOOKABLE.fullmatch(low) and not self.is_known(low)
+                self._read_as[word] = self.target(low) if unknown else None
         return {word: self._read_as[word] for word in _WORD.findall(text) if self._read_as[word]}
 
     def rewrite(self, text: str) -> str:

@@ -12,6 +12,13 @@ from dataclasses import dataclass
 #: The language encoders a ModelConfig may name: the paper's LSTM (PGAE), the frozen pretrained
 #: transformer (PGAE-BERT), and the transformer read through a trained attention pooling (not in the paper).
 LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
+CELLS = ("lstm", "peephole")
+JOINT_FEEDBACKS = ("start", "predicted")
+
+
+def _whole(name: str, value, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < low:
+        raise ValueError(f"ModelConfig {name} must be a whole number >= {low}; got {value!r}")
 
 
 @dataclass
@@ -50,6 +57,15 @@ class ModelConfig:
     plan_keyframes: int = 10
 
     def __post_init__(self):
+        for name in ("units", "layers", "hidden"):
+            _whole(name, getattr(self, name), 1)
+        if self.cell not in CELLS:
+            raise ValueError(f"unknown cell {self.cell!r}; the options are: {', '.join(CELLS)}")
+        if self.joint_feedback not in JOINT_FEEDBACKS:
+            raise ValueError(f"unknown joint_feedback {self.joint_feedback!r}; the options are: "
+                             f"{', '.join(JOINT_FEEDBACKS)}")
+        if not isinstance(self.gmu_norm, bool):
+            raise ValueError(f"gmu_norm must be True or False; got {self.gmu_norm!r}")
         if isinstance(self.plan_keyframes, bool) or not isinstance(self.plan_keyframes, int) \
                 or self.plan_keyframes < 0:
             raise ValueError(f"plan_keyframes must be a whole number >= 0 (0 = no plan head, the paper's); "
@@ -71,4 +87,4 @@ class ModelConfig:
         return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
 
-__all__ = ["LANGUAGE_ENCODERS", "ModelConfig"]
+__all__ = ["CELLS", "JOINT_FEEDBACKS", "LANGUAGE_ENCODERS", "ModelConfig"]

@@ -41,7 +41,7 @@ from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table
 from pgae_lite.train.loop import train
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.util.storage import atomic_write, atomic_write_text
+from pgae_lite.util.storage import atomic_path, atomic_write, atomic_write_text, make_folder
 from pgae_lite.world.words import TEST_SIGNALS
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
@@ -156,7 +156,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
                profile: Profile, device: str | None = None, progress: bool = True,
                pretrained_model: str | None = None) -> dict:
     """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)                 # a file in the way, or no permission: one sentence
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:
         report["rows"][row] = {"training": ROWS[row][0], "paper": {
@@ -185,7 +185,8 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
         mean, std = summarise([report["rows"][row]["seeds"][str(s)] for s in seeds])
         report["rows"][row] |= {"mean": mean, "std": std}
     first = out / f"{ROWS[rows[0]][0]}-seed{seeds[0]}" / f"predictions-{rows[0]}.npz"
-    shutil.copyfile(first, out / "predictions.npz")
+    with atomic_path(out / "predictions.npz") as tmp:   # never through a link, never half-written
+        shutil.copyfile(first, tmp)
     return report
 
 

@@ -17,7 +17,7 @@ from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.train.config import saved_model_config
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import default_device, load_torch, save_torch
+from pgae_lite.util.storage import CorruptCheckpointError, default_device, load_torch, save_torch
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.
@@ -95,6 +95,11 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
                                 cfg.get("vision_scaling", "global")).state_dict()
         check_trained_on(ckpt, fitted, path, dataset.source)
+    broken = [k for k, v in ckpt["model"].items() if torch.is_tensor(v) and v.is_floating_point()
+              and not torch.isfinite(v).all()]
+    if broken:
+        raise CorruptCheckpointError(f"{path} holds non-finite weights (NaN or infinite) in {', '.join(broken[:3])}"
+                                     f"{' ...' if len(broken) > 3 else ''}: the model cannot be used; train it again")
     model = build_pgae(saved_model_config(ckpt["profile"], path))
     model.load_state_dict(ckpt["model"])
     model.to(device or default_device()).eval()

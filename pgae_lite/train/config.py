@@ -6,6 +6,7 @@ to is on the book's results page (appendix A2), not in these comments.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from pgae_lite.data.dataset import check_vision_scaling
@@ -22,6 +23,21 @@ RECIPE_VERSION = 2
 #: The signals that take a description, and so may read phrasings (TrainConfig.phrasing_signals).
 PHRASING_SIGNALS = ("execute", "repeat both", "repeat language")
 PHRASING_WORDS = ("all", "held-out")
+SCHEDULES = ("cosine", "constant")
+
+
+def _number(name: str, value, low: float, high: float = math.inf, *, above: bool = False,
+            optional: bool = False) -> None:
+    """A ValueError unless ``value`` is a finite number in [low, high] (``above``: > low)."""
+    if optional and value is None:
+        return
+    ok = not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value) \
+        and (value > low if above else value >= low) and value <= high
+    if not ok:
+        bound = f"> {low}" if above else f">= {low}"
+        bound += f" and <= {high}" if high != math.inf else ""
+        raise ValueError(f"TrainConfig {name} must be a number {bound}{' or None' if optional else ''}; "
+                         f"got {value!r}")
 
 
 @dataclass
@@ -84,6 +100,20 @@ class TrainConfig:
     checkpoint_every: int = 25          # epochs between checkpoints
 
     def __post_init__(self):
+        _number("lr", self.lr, 0, above=True)
+        _number("warmup", self.warmup, 0, 0.99)                 # a fraction of the steps: 1 never leaves it
+        _number("clip", self.clip, 0, above=True, optional=True)
+        _number("weight_decay", self.weight_decay, 0)
+        _number("opposite_prob", self.opposite_prob, 0, 1)
+        _number("input_noise", self.input_noise, 0)
+        _number("joint_input_noise", self.joint_input_noise, 0, optional=True)
+        for name in ("language_weight", "action_weight", "plan_weight"):   # α, β, γ: a negative one maximises
+            _number(name, getattr(self, name), 0)
+        if self.schedule not in SCHEDULES:
+            raise ValueError(f"unknown schedule {self.schedule!r}; the options are: {', '.join(SCHEDULES)}")
+        for name in ("length_batches", "signals_per_sample", "teacher_language"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"TrainConfig {name} must be True or False; got {getattr(self, name)!r}")
         probs = tuple(float(q) for q in self.signal_probs)
         if len(probs) != len(SIGNALS) or min(probs) < 0 or abs(sum(probs) - 1) > 1e-6:
             raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "

@@ -142,11 +142,15 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` to write to; it replaces ``path`` when the block ends.
 
     The rename (``os.replace``) is atomic, so ``path`` holds either its old
-    contents or the whole new file, never part of it. If the block raises, the
+    contents or the whole new file, never part of it. A symbolic link at ``path``
+    is refused (:class:`OutputError`): a write never goes through a link. If the block raises, the
     temporary file is removed and ``path`` is left as it was. The temporary
     name holds the process id and a random part: parallel writers never share one.
     """
     path = Path(path)
+    if path.is_symlink():       # a link planted in a shared folder must not redirect the write
+        raise OutputError(f"refusing to write {path}: it is a symbolic link (to {os.readlink(path)}); "
+                          "remove the link or write to another folder")
     if path.is_dir():
         raise OutputError(f"cannot write {path}: it is a folder; name a file")
     tmp = path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp")
