@@ -122,3 +122,38 @@ def test_a_checkpoint_with_non_finite_weights_is_refused(tmp_path, toy_short):
     with pytest.raises(CorruptCheckpointError, match="holds non-finite weights .* train it again"):
         load_model(tmp_path / CHECKPOINT, device="cpu")
     assert os.path.exists(tmp_path / CHECKPOINT)          # refused, not deleted
+
+
+# --------------------------------------------------------------------------- more inputs of the report
+def test_a_pattern_outside_the_world_is_refused():
+    from pgae_lite.world.colours import DEFAULT_WORLD
+
+    with pytest.raises(ValueError, match="arrangement must be a whole number from 0 to 11 in this world; got 99"):
+        DEFAULT_WORLD.pattern_number(0, 99, 0)
+    assert DEFAULT_WORLD.pattern_number(1, 11, 5) == 143
+
+
+def test_readbacks_and_instructions_must_pair_up():
+    from pgae_lite.robot.instructions import acted_on
+
+    with pytest.raises(ValueError, match="one readback per instruction; got 1 readbacks for 2 instructions"):
+        acted_on(["push red fast"], ["shove the red cube", "pull it"])
+
+
+def test_is_correct_wants_a_text():
+    from pgae_lite.world.words import LanguageError, is_correct
+
+    with pytest.raises(LanguageError, match="compares a generated text"):
+        is_correct(None, [("push", "red", "fast")])
+
+
+def test_the_cache_variable_naming_a_file_or_empty_is_one_sentence(tmp_path, monkeypatch):
+    from pgae_lite.util.storage import CACHE_ENV, cache_dir
+
+    (tmp_path / "afile").write_text("")
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path / "afile"))
+    with pytest.raises(OutputError, match="is a file; name a folder"):
+        cache_dir()
+    monkeypatch.setenv(CACHE_ENV, "")
+    with pytest.raises(OutputError, match="is set but empty"):
+        cache_dir()

@@ -52,5 +52,5 @@ def test_config_digest_is_the_cache_keys_formula():
 def test_cache_dir(monkeypatch, tmp_path):
     monkeypatch.setenv(CACHE_ENV, str(tmp_path))
     assert cache_dir() == tmp_path
-    monkeypatch.setenv(CACHE_ENV, "")
+    monkeypatch.delenv(CACHE_ENV)                     # unset: the home cache (set but empty: refused)
     assert cache_dir().parts[-2:] == (".cache", "pgae_lite")

@@ -78,6 +78,9 @@ def say_back(model: PGAE, data: PGAEDataset, normaliser: Normaliser, texts: list
 def acted_on(said: list[str], texts: list[str]) -> list[str]:
     """What ``route="said back"`` executes: the words said back where they are a description
     (action colour speed; hyphens read as spaces), else the instruction itself."""
+    if len(said) != len(texts):
+        raise ValueError(f"acted_on needs one readback per instruction; got {len(said)} readbacks "
+                         f"for {len(texts)} instructions")
     out = []
     for back, text in zip(said, texts):
         try:

@@ -58,8 +58,15 @@ class FolderBusyError(PGAELiteError, RuntimeError):
 
 
 def cache_dir() -> Path:
-    """Root of every cache: ``$PGAE_LITE_CACHE``, else ``~/.cache/pgae_lite``."""
-    return Path(os.environ.get(CACHE_ENV) or Path.home() / ".cache" / "pgae_lite").expanduser()
+    """Root of every cache: ``$PGAE_LITE_CACHE``, else ``~/.cache/pgae_lite``; a file there, or the
+    variable set but empty, is refused with one sentence (:class:`OutputError`)."""
+    given = os.environ.get(CACHE_ENV)
+    if given is not None and not given.strip():
+        raise OutputError(f"{CACHE_ENV} is set but empty; unset it for ~/.cache/pgae_lite, or name a folder")
+    folder = Path(given or Path.home() / ".cache" / "pgae_lite").expanduser()
+    if folder.exists() and not folder.is_dir():
+        raise OutputError(f"the cache folder {folder} ({CACHE_ENV}) is a file; name a folder")
+    return folder
 
 
 def default_device() -> torch.device:

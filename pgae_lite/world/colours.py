@@ -99,6 +99,10 @@ class World:
 
     def pattern_number(self, speed: int, arrangement: int, action: int) -> int:
         """The paper's numbering to arrangement 11, then :data:`EXTENSION_NUMBERING`."""
+        for name, value, count in (("speed", speed, 2), ("arrangement", arrangement, len(self.arrangements)),
+                                   ("action", action, 6)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 0 <= value < count:
+                raise ValueError(f"{name} must be a whole number from 0 to {count - 1} in this world; got {value!r}")
         if arrangement < len(ARRANGEMENTS):
             return pattern_number(speed, arrangement, action)
         k = arrangement - len(ARRANGEMENTS)                # the k-th added arrangement

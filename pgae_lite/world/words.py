@@ -312,6 +312,9 @@ def is_correct(generated: str, alternatives: list[tuple[str, ...]] | None) -> bo
 
     ``alternatives=None`` means the expected output is ``<EOS>`` alone (empty text).
     """
+    if not isinstance(generated, str):
+        raise LanguageError(f"is_correct compares a generated text (a string, '' for <EOS> alone); "
+                            f"got {generated!r}")
     if alternatives is None:
         return generated == ""
     return tuple(generated.split()) in {tuple(a) for a in alternatives}
