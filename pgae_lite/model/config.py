@@ -16,9 +16,10 @@ CELLS = ("lstm", "peephole")
 JOINT_FEEDBACKS = ("start", "predicted")
 
 
-def _whole(name: str, value, low: int) -> None:
+def _whole(name: str, value, low: int, meaning: str = "") -> None:
+    """A ValueError unless ``value`` is a whole number >= ``low`` (``meaning``: what a value means)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < low:
-        raise ValueError(f"ModelConfig {name} must be a whole number >= {low}; got {value!r}")
+        raise ValueError(f"ModelConfig {name} must be a whole number >= {low}{meaning}; got {value!r}")
 
 
 @dataclass
@@ -66,10 +67,8 @@ class ModelConfig:
                              f"{', '.join(JOINT_FEEDBACKS)}")
         if not isinstance(self.gmu_norm, bool):
             raise ValueError(f"gmu_norm must be True or False; got {self.gmu_norm!r}")
-        if isinstance(self.plan_keyframes, bool) or not isinstance(self.plan_keyframes, int) \
-                or self.plan_keyframes < 0:
-            raise ValueError(f"plan_keyframes must be a whole number >= 0 (0 = no plan head, the paper's); "
-                             f"got {self.plan_keyframes!r}")
+        _whole("plan_keyframes", self.plan_keyframes, 0, " (0 = no plan head, the paper's)")
+        _whole("time_stride", self.time_stride, 1, " (1 = every step, the paper's)")
         if self.language_encoder not in LANGUAGE_ENCODERS:
             raise ValueError(f"unknown language_encoder {self.language_encoder!r}; "
                              f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
@@ -78,9 +77,6 @@ class ModelConfig:
         if self.tuned_top_layer and self.language_encoder != "pretrained-attention":
             raise ValueError(f"tuned_top_layer needs language_encoder='pretrained-attention' (the free-form "
                              f"variant's encoder); got language_encoder={self.language_encoder!r}")
-        if not isinstance(self.time_stride, int) or self.time_stride < 1:
-            raise ValueError(f"time_stride must be a whole number >= 1 (1 = every step, the paper's); "
-                             f"got {self.time_stride!r}")
 
     @property
     def state_dim(self) -> int:

@@ -41,9 +41,11 @@ class TypedText:
         return self.words is None
 
     def features(self, signal: str) -> torch.Tensor:
-        """(1, D): the encoder's features of the text after ``signal``'s phrase, computed once per signal."""
+        """(1, D): the encoder's features of the text after ``signal``'s phrase, computed once per signal.
+
+        The encoder reads the typed text as :attr:`read` shows it (its own lookup, applied once there)."""
         if signal not in self._features:
-            self._features[signal] = self.encoder.encode_texts([input_text(signal, self.read)])
+            self._features[signal] = self.encoder.encode_texts([input_text(signal, self.typed)])
         return self._features[signal]
 
 
@@ -64,8 +66,7 @@ def read_typed(encoder: nn.Module, signal: str, text: str) -> TypedText:
             raise LanguageError(f"{signal!r} reads no words, so text can only pick the episode, and that takes "
                                 f"a description: {e}") from None
         words = meaning = None
-    read = encoder.read_as(text) if encoder.reads_free_text else text
-    return TypedText(text, read, words, meaning, encoder)
+    return TypedText(text, encoder.read_as(text), words, meaning, encoder)
 
 
 __all__ = ["TypedText", "read_typed"]

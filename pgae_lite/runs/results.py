@@ -67,7 +67,7 @@ def names() -> list[str]:
     """The result files there, by name (``table1-original`` for ``results/table1-original.json``;
     ``history/NAME`` for a superseded one in ``results/history/``)."""
     folder = results_dir()
-    return sorted(p.relative_to(folder).with_suffix("").as_posix() for p in folder.glob("*.json")) + \
+    return sorted(p.stem for p in folder.glob("*.json")) + \
         sorted(f"history/{p.stem}" for p in (folder / "history").glob("*.json"))
 
 

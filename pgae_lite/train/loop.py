@@ -57,6 +57,7 @@ class Run:
     optimiser: torch.optim.Optimizer
     gen: torch.Generator                 # signals, descriptions, views, shuffling
     data: dict[str, torch.Tensor]        # the training samples, normalised, on the device
+    lengths: torch.Tensor                # each sample's length, on the CPU (for the batches)
     plans: torch.Tensor | None           # each sample's plan target (model/plan.py), if the model has a head
     batches: int                         # per epoch
     epoch: int = 0
@@ -152,8 +153,9 @@ def _setup(train_set: PGAEDataset, normaliser: Normaliser, profile, device: torc
     optimiser = (torch.optim.AdamW(groups, lr=cfg.lr, weight_decay=cfg.weight_decay, **fused)
                  if cfg.weight_decay else torch.optim.Adam(groups, lr=cfg.lr, **fused))
     gen = torch.Generator().manual_seed(cfg.seed)
-    batches = len(batch_indices(data["lengths"].cpu(), cfg.batch_size, torch.Generator(), cfg.length_batches))
-    return Run(model, optimiser, gen, data, plans, batches)
+    lengths = data["lengths"].cpu()
+    batches = len(batch_indices(lengths, cfg.batch_size, torch.Generator(), cfg.length_batches))
+    return Run(model, optimiser, gen, data, lengths, plans, batches)
 
 
 def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) -> None:
@@ -174,8 +176,7 @@ def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) 
 def _epoch(run: Run, cfg, epoch: int, weights: torch.Tensor, bank, device: torch.device) -> dict:
     """One epoch: every batch a step; returns (and keeps in the history) the epoch's record."""
     run.model.train()
-    lengths = run.data["lengths"].cpu()
-    epoch_batches = batch_indices(lengths, cfg.batch_size, run.gen, cfg.length_batches)
+    epoch_batches = batch_indices(run.lengths, cfg.batch_size, run.gen, cfg.length_batches)
     total = cfg.epochs * run.batches
     sums = torch.zeros(3)
     gate_sum, gate_n = torch.zeros(len(SIGNALS)), torch.zeros(len(SIGNALS))
@@ -193,7 +194,7 @@ def _epoch(run: Run, cfg, epoch: int, weights: torch.Tensor, bank, device: torch
         z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
         gate_sum.index_add_(0, batch.signal, z)
         gate_n.index_add_(0, batch.signal, torch.ones(len(index)))
-    loss, lang, act = (sums / len(lengths)).tolist()
+    loss, lang, act = (sums / len(run.lengths)).tolist()
     gates = (gate_sum / gate_n.clamp(min=1)).tolist()
     run.history.append({"epoch": epoch + 1, "loss": loss, "language_loss": lang, "action_loss": act,
                         "lr": run.optimiser.param_groups[0]["lr"],
