@@ -31,6 +31,7 @@ from torch import nn
 from pgae_lite.bert.pretrained import (
     Transformer,
     check_texts,
+    check_token_ids,
     fixed_inputs,
     load_transformer,
     model_name,
@@ -188,7 +189,7 @@ class AttentivePretrainedEncoder(nn.Module):
 
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
         """``lang_tokens`` (B, 5) -> (B, output_dim); rows outside the fixed 869 run the transformer."""
-        rows = table_rows(tokens, self.row_of_code).to(self.mask.device)
+        rows = table_rows(check_token_ids(tokens), self.row_of_code).to(self.mask.device)
         known = rows.clamp(min=0)
         out = self.pool(self.states[known], self.mask[known])
         missing = (rows < 0).nonzero().flatten()

@@ -36,7 +36,8 @@ from pgae_lite.bert.transformer import (
 from pgae_lite.model.signals import EOS, LANG_IN, SIGNAL_TOKEN
 from pgae_lite.util.checks import shown
 from pgae_lite.util.storage import cache_dir, save_torch
-from pgae_lite.world.words import SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError, normalise_signal
+from pgae_lite.world.words import (INPUT_DIM, SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
+                                   normalise_signal)
 
 POOLINGS = ("mean", "cls")
 CACHE_FORMAT = 1          # bump when the texts or the file layout change: old files are recomputed
@@ -114,6 +115,16 @@ def fixed_inputs() -> tuple[list[str], torch.Tensor]:
     row_of_code = torch.full((len(SIGNALS) * WORDS ** 3,), -1)
     row_of_code[token_codes(rows)] = torch.arange(len(rows))
     return [tokens_to_text(r) for r in rows], row_of_code
+
+
+def check_token_ids(tokens: torch.Tensor) -> torch.Tensor:
+    """``tokens`` when every id is a word or a signal (0-27); else a LanguageError (a negative id would
+    wrap round to a word, one past the table would fail deep inside)."""
+    low, high = torch.aminmax(tokens) if tokens.numel() else (0, 0)
+    if low < 0 or high >= INPUT_DIM:
+        raise LanguageError(f"token ids must be from 0 to {INPUT_DIM - 1} ({len(VOCABULARY)} words, then "
+                            f"{len(SIGNALS)} signals); got ids from {int(low)} to {int(high)}")
+    return tokens
 
 
 def table_rows(tokens: torch.Tensor, row_of_code: torch.Tensor) -> torch.Tensor:
@@ -199,7 +210,7 @@ class PretrainedLanguageEncoder(nn.Module):
         ``lengths`` is not needed (a row's text ends at its first <EOS>); it is accepted so
         that both language encoders are called the same way.
         """
-        rows = table_rows(tokens, self.row_of_code)
+        rows = table_rows(check_token_ids(tokens), self.row_of_code)
         out = self.table[rows.clamp(min=0)]
         missing = (rows < 0).nonzero().flatten()
         if len(missing):
@@ -247,6 +258,6 @@ class PretrainedLanguageEncoder(nn.Module):
 
 
 __all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError",
-           "Transformer", "check_texts", "fixed_token_rows", "input_text",
+           "Transformer", "check_texts", "check_token_ids", "fixed_token_rows", "input_text",
            "fixed_inputs", "load_transformer", "model_name", "model_source", "table_rows", "token_codes",
            "token_vectors", "tokens_to_text"]

@@ -10,6 +10,8 @@ compute, the key of every cache of their outputs.
 from __future__ import annotations
 
 import hashlib
+import pickle
+import re
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -111,6 +113,12 @@ def load_transformer(name: str | None = None, download: bool = False) -> Transfo
         path = str(Path(source).expanduser()) if source.startswith("~") else source
         tokenizer = AutoTokenizer.from_pretrained(path, local_files_only=not download)
         model = AutoModel.from_pretrained(path, local_files_only=not download)
+    except pickle.UnpicklingError as e:        # a weights file that holds more than tensors: never run
+        named = re.search(r"GLOBAL (\S+)", str(e))
+        raise PretrainedModelError(
+            f"refusing the pretrained model {name!r} from {source!r}: its weights file is a pickle that holds "
+            f"more than tensors{f' (it names {named.group(1)})' if named else ''}, and such a file can run "
+            f"code when loaded; give the weights as model.safetensors, or as a pickle of tensors alone") from None
     except (OSError, ValueError) as e:
         raise PretrainedModelError(
             f"could not load the pretrained model {name!r} from {source!r}"

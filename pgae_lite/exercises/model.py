@@ -27,6 +27,7 @@ from pgae_lite.model.pgae import PGAE, count_parameters
 from pgae_lite.model.signals import SIGNAL_PROBS, make_batch, sample_signals
 from pgae_lite.data.toy import toy_dataset
 from pgae_lite.train.loss import pgae_loss
+from pgae_lite.util.checks import MAX_SEED, whole_number
 from pgae_lite.exercises.result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
                      _pair, _shape, _unchanged, _value_problem)
 
@@ -49,7 +50,7 @@ def _step(x, h, c, cell, order="ijfo", forget_bias=0.8, peepholes=True, tanh_j=T
 
 @torch.random.fork_rng(devices=[])  # every check leaves the student's global random state alone
 def _check_step(student: Callable, peepholes: bool, name: str, seed: int) -> CheckResult:
-    result, gen = CheckResult(name), torch.Generator().manual_seed(seed)
+    result, gen = CheckResult(name), torch.Generator().manual_seed(whole_number("seed", seed, 0, MAX_SEED))
     cell = PeepholeLSTMCell(3, 4)
     with torch.no_grad():  # U(-1, 1), not U(-0.1, 0.1): every term of the equation then shows
         for p in cell.parameters():
@@ -115,7 +116,7 @@ def check_gmu(student: type | nn.Module | Callable, seed: int = 0) -> CheckResul
     the reference weights into them; an instance is rebuilt from its class), or a function
     ``f(gmu, f_action, f_language) -> (h, z)`` that uses the layers of the reference ``gmu``.
     """
-    result, gen = CheckResult("GMU forward"), torch.Generator().manual_seed(seed)
+    result, gen = CheckResult("GMU forward"), torch.Generator().manual_seed(whole_number("seed", seed, 0, MAX_SEED))
     A, L, H, B = 7, 5, 4, 6
     ref = GatedMultimodalUnit(A, L, H)
     with torch.no_grad():
@@ -172,6 +173,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     alone with unequal action and language sizes (as in PGAE-BERT), then as ``model.gmu`` of a tiny
     PGAE (``cell`` "lstm" or "peephole"): a forward and a backward pass on a toy batch.
     """
+    seed = whole_number("seed", seed, 0, MAX_SEED)
     result, gen = CheckResult("bottleneck in PGAE"), torch.Generator().manual_seed(seed)
     torch.manual_seed(seed)                                  # the student's initialisation: the same every run
     A, L, H, B = 12, 9, 6, 4

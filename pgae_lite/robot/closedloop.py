@@ -54,6 +54,7 @@ from pgae_lite.data.simulated import DatasetConfig
 from pgae_lite.evaluate import predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
+from pgae_lite.robot.refusals import check_instruction
 from pgae_lite.sim.record import Execution, Simulation
 from pgae_lite.sim.robot import HOME_POSE
 from pgae_lite.viz import animate_frames
@@ -127,7 +128,8 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
     precomputed language features in place of the words, e.g. free text through
     a pretrained encoder (``model.language_encoder.encode_texts([text])``),
     passed on as ``model.encode(batch, language=language)``; ``description`` is
-    then only the rollout's label.
+    then only the rollout's label, and the instruction checked: text the robot will not act on
+    (:mod:`pgae_lite.robot.refusals`) raises :class:`~pgae_lite.robot.refusals.CannotDo`.
     """
     config = config or PROFILES["book"].data
     model.eval()
@@ -137,6 +139,9 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
         text = " ".join(words)
     else:                     # the features carry the words: the batch's own tokens go unused
         words, text = words_of(pattern, None, alternative), description or ""
+        if text and model.language_encoder.reads_free_text:   # free text: first, whether the robot can
+            p = Pattern.from_number(pattern)
+            check_instruction(text, model.language_encoder, (p.left, p.right))
     steps = steps or Pattern.from_number(pattern).steps
 
     def features(frame: np.ndarray) -> torch.Tensor:          # frame -> v_t (1, 30), model units

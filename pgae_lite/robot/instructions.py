@@ -26,6 +26,8 @@ from pgae_lite.evaluate import predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
 from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
+from pgae_lite.robot.refusals import refusal
+from pgae_lite.util.checks import whole_number
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
 
@@ -40,6 +42,8 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
     else a :class:`~pgae_lite.world.words.LanguageError` names the unknown words.
     """
     texts, encoder = check_texts("instruction_features", texts), model.language_encoder
+    if not texts:
+        raise LanguageError("instruction_features takes at least one instruction; got an empty list")
     if encoder.reads_free_text:                                   # PGAE-BERT
         return encoder.encode_texts([input_text("execute", t) for t in texts])
     for t in texts:
@@ -119,9 +123,13 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     the recorded joints of the episode, the intended action. ``limit``: that many
     episodes, evenly spread. ``route``: ``"direct"`` (the paper's: the instruction's
     features) or ``"said back"`` (:func:`say_back`, then those words; the ``acted_on``
-    column).
+    column). Instructions the robot will not act on (:mod:`pgae_lite.robot.refusals`: a negation,
+    more than one instruction, a cube not in the episode's scene, ...) are not executed: their
+    ``refused`` column says why (it is empty for the others).
     """
     check_route(route)
+    if limit is not None:
+        whole_number("limit", limit, 1)
     paraphrases = load_paraphrases() if paraphrases is None else paraphrases
     subset = data.split(split)
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]
@@ -131,17 +139,32 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     rows = rows[spread(len(rows), limit)]
     episodes, told = subset.subset(rows), [told[i] for i in rows]
     texts = [t.text for t in told]
+    language = instruction_features(model, texts)                             # (N, D); PGAE's LSTM: refused here
+    said, refused = [None] * len(texts), [None] * len(texts)      # PGAE's LSTM: descriptions, none refused
+    if model.language_encoder.reads_free_text:
+        said = say_back(model, episodes, normaliser, texts)
+        refused = [refusal(text, model.language_encoder, scene_of(int(p)), back)   # robot/refusals.py
+                   for text, p, back in zip(texts, episodes.pattern, said)]
     if route == "said back":
-        texts = acted_on(say_back(model, episodes, normaliser, texts), texts)
-    language = instruction_features(model, texts)                             # (N, D)
+        texts = acted_on(said, texts)
+        language = instruction_features(model, texts)
     planned = predict(model, episodes, normaliser, "execute", language=language).joints   # the paper's execute
     joint_range = data.joint_range()
-    return pd.DataFrame([
-        {**execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text, joint_range,
-                           language=language[k:k + 1], closed=closed, config=config, tracking=tracking),
-         "meaning": " ".join(told[k].meaning), "acted_on": texts[k]}
-        for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress)])
+    rows = []
+    for k in tqdm(range(len(episodes)), desc="paraphrases", unit="ep", disable=not progress):
+        row = {"id": episodes.ids[k], "pattern": int(episodes.pattern[k]), "description": told[k].text} \
+            if refused[k] else execute_episode(model, cae, normaliser, episodes, k, planned[k], told[k].text,
+                                               joint_range, language=language[k:k + 1], closed=closed,
+                                               config=config, tracking=tracking)
+        rows.append({**row, "meaning": " ".join(told[k].meaning), "acted_on": texts[k], "refused": refused[k] or ""})
+    return pd.DataFrame(rows)
+
+
+def scene_of(pattern: int) -> tuple[str, str]:
+    """The colours of the (left, right) cubes in ``pattern``'s scene."""
+    p = Pattern.from_number(pattern)
+    return p.left, p.right
 
 
 __all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of",
-           "execute_paraphrases"]
+           "execute_paraphrases", "scene_of"]

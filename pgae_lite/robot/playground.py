@@ -14,7 +14,10 @@ Text. Under ``execute`` and ``repeat language`` the model reads the words: a
 typed description (``action colour speed``, any synonym) replaces the
 episode's and picks the episode itself, the action it names in the chosen
 arrangement. PGAE's LSTM reads only those 22 words; PGAE-BERT's transformer
-reads any text (paper, Sec. 3), then the chosen action is the one meant.
+reads any text (paper, Sec. 3), then the chosen action is the one meant. Free text the robot
+will not act on under ``execute`` (a negation, more than one instruction, a cube not on the
+table: :mod:`pgae_lite.robot.refusals`) is refused with the reason; where the model's readback
+and the chosen action disagree, the result's ``note`` says so.
 Under ``describe`` and ``repeat action`` the model reads no words, and a typed
 description only picks the episode. Bad text raises a
 :class:`~pgae_lite.world.words.LanguageError` that says what is wrong.
@@ -25,15 +28,10 @@ calls :func:`play` and shows the result, or the error's message.
 from __future__ import annotations
 
 import html
-import io
-import textwrap
-from dataclasses import dataclass
 from typing import Mapping
 
-import matplotlib.pyplot as plt
 import numpy as np
 import torch
-from matplotlib.figure import Figure
 
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import ChannelSeparatedCAE
@@ -44,13 +42,13 @@ from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
 from pgae_lite.robot.instructions import acted_on, check_route
+from pgae_lite.robot.play_result import TARGETS, PlayResult
 from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number, check_objects,
                                                 check_playground)
+from pgae_lite.robot.refusals import check_instruction, disagreement
 from pgae_lite.robot.typed_text import read_typed
-from pgae_lite.sim.record import Execution
-from pgae_lite.util.checks import instance_of, positive_number, whole_number
+from pgae_lite.util.checks import instance_of, whole_number
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.viz import animate_frames, plot_joints
 from pgae_lite.world import patterns
 from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
 from pgae_lite.world.words import (
@@ -68,12 +66,6 @@ PLAY_SIGNALS: tuple[str, ...] = ("describe", "execute", "repeat action", "repeat
 #: action k is pattern 72·(k // 6) + 6·arrangement + k % 6.
 ACTIONS: tuple[tuple[str, str, str], ...] = tuple((a, side, speed) for speed in ("slowly", "fast")
                                                   for a, side in ACTION_SIDES)
-#: What the joints of each signal should be (the action decoder's target, from the recorded episode).
-TARGETS: dict[str, str] = {"describe": "the final recorded pose, held", "execute": "the recorded joints",
-                           "repeat action": "the recorded joints", "repeat both": "the recorded joints",
-                           "repeat language": "the first recorded pose, held"}
-
-
 def arrangement_label(arrangement: int) -> str:
     """E.g. ``"red left, blue right"`` for arrangement 0."""
     left, right = ARRANGEMENTS[arrangement_number(arrangement)]
@@ -115,87 +107,6 @@ def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[i
     row = int(rows[variation])
     name = str(data.ids[row])                                   # "sim/PPP-V" for our simulator's episodes
     return row, int(name.rsplit("-", 1)[1]) if name.startswith("sim/") else variation
-
-
-@dataclass
-class PlayResult:
-    """What one call of :func:`play` produced (joints in data units, steps 0..length-1)."""
-
-    signal: str
-    pattern: int
-    variation: int            # the simulator's variation of the episode
-    episode: str              # the episode's id in the dataset
-    told: str                 # the model's language input as text, e.g. "execute push red slowly"
-    words: str                # generated description, "" for <EOS> alone
-    correct: bool             # the paper's criterion for this signal
-    joints: np.ndarray        # (length, 5) predicted (closed loop: what the loop asked for)
-    target: np.ndarray        # (length, 5) what the signal asks for (see TARGETS)
-    nrmse: float              # % of the dataset's joint range, over steps 1..length-1
-    gate: np.ndarray          # (hidden,) GMU gate z: 1 lets the action through, 0 the language
-    rollout: Execution | None  # the simulator's execution of ``joints`` (None: not simulated)
-    loop: str | None = None   # "open", "closed" or None: how the simulator ran the joints
-    understood: str | None = None  # typed text said back (``repeat language``): what the model took it to mean
-
-    def summary(self) -> str:
-        """A few lines of plain text: task, episode, words, joint error, the simulator's verdict."""
-        p = Pattern.from_number(self.pattern)
-        expected = LANG_OUT[SIGNALS.index(self.signal)]
-        lines = [f"signal: {self.signal}   model reads: {self.told!r}",
-                 f"episode {self.episode}: {p.action} the {p.colour} cube {p.speed} ({p.left} left, {p.right} right)",
-                 f"words: {self.words or '<EOS>'!r} ({'right' if self.correct else 'wrong'}: expected "
-                 f"{'a description of the action' if expected else '<EOS> alone'})",
-                 f"joints: nRMSE {self.nrmse:.2f}% against {TARGETS[self.signal]}; "
-                 f"mean gate z {self.gate.mean():.2f} (0 = language, 1 = action)"]
-        if self.understood is not None:
-            said = self.understood or "<EOS>"
-            lines.insert(1, f"I understood: {said} (the typed text said back with repeat language)")
-        if self.rollout is not None:
-            verdict = "the cube moved as told" if self.rollout.passed else f"failed ({self.rollout.check.reason})"
-            held = self.signal in ("describe", "repeat language")
-            lines.append(f"robot, {self.loop} loop: {verdict}" + ("; this signal asks for a pose, not an action"
-                                                                   if held else ""))
-        return "\n".join(lines)
-
-    def figure(self) -> Figure:
-        """Predicted joints against the target (left) and the GMU gate per dimension of h (right)."""
-        fig, (left, right) = plt.subplots(1, 2, figsize=(10, 3.2), gridspec_kw={"width_ratios": [2, 1]})
-        plot_joints(self.joints, self.target, title=f"{self.signal}: target is {TARGETS[self.signal]}", ax=left)
-        right.bar(np.arange(len(self.gate)), self.gate, color=plt.cm.coolwarm(self.gate), width=1.0)
-        right.axhline(self.gate.mean(), color="black", lw=1, ls=":")
-        right.set(ylim=(0, 1), xlabel="dimension of h", ylabel="z (0 language, 1 action)",
-                  title=f"GMU gate, mean {self.gate.mean():.2f}")
-        fig.tight_layout()
-        return fig
-
-    def animation(self, every: int = 4, size: float = 3.0, dpi: int = 60):
-        """The robot executing the joints, from NICO's eye, and its joints (a matplotlib animation), or None."""
-        whole_number("every", every, 1), whole_number("dpi", dpi, 1)
-        positive_number("size", size)
-        if self.rollout is None:
-            return None
-        title = f"{textwrap.shorten(self.told, 36)}: {'done' if self.rollout.passed else 'failed'}"
-        return animate_frames({"NICO's eye": self.rollout.frames}, joints=self.rollout.measured, every=every,
-                              size=size, dpi=dpi, title=title)
-
-    def displays(self, every: int = 4) -> list:
-        """IPython display objects: the summary (HTML), the figure (PNG) and the animation (HTML)."""
-        from IPython.display import HTML, Image
-
-        fig = self.figure()
-        png = io.BytesIO()
-        fig.savefig(png, format="png", dpi=80)
-        plt.close(fig)                                  # shown once, as the PNG, not again by the backend
-        out = [HTML("<pre>" + html.escape(self.summary()) + "</pre>"), Image(data=png.getvalue(), format="png")]
-        anim = self.animation(every)
-        if anim is not None:
-            out.append(HTML(anim.to_jshtml()))          # frames embedded as PNGs: plays offline
-        return out
-
-    def show(self, every: int = 4) -> None:
-        """Display everything in a notebook."""
-        from IPython.display import display
-
-        display(*self.displays(every))
 
 
 @torch.no_grad()
@@ -245,6 +156,11 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
         back_language = typed.features("repeat language") if free else None
         back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
         understood = decode(back["logits"][0].argmax(-1).cpu())
+    note = None
+    if free and signal == "execute":                      # the robot acts: first, whether it can (refusals.py)
+        scene = Pattern.from_number(pattern)
+        check_instruction(text, model.language_encoder, (scene.left, scene.right), understood)
+        note = disagreement(understood, pattern)
     language = None
     if free and route == "said back" and signal == "execute":   # act on its own words
         said = acted_on([understood], [said])[0]
@@ -272,7 +188,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     nrmse = 100 * float(np.sqrt(np.mean((joints[1:] - target[1:]) ** 2))) / data.joint_range()
     return PlayResult(signal, pattern, sim_variation, str(data.ids[row]), told, generated,
                       is_correct(generated, expected if LANG_OUT[SIGNALS.index(signal)] else None),
-                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood)
+                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood, note)
 
 
 class Playground:
@@ -343,5 +259,5 @@ class Playground:
         return self.widget._repr_mimebundle_(**kwargs)
 
 
-__all__ = ["ACTIONS", "PLAY_SIGNALS", "PlayResult", "Playground", "action_label", "arrangement_label",
+__all__ = ["ACTIONS", "PLAY_SIGNALS", "TARGETS", "PlayResult", "Playground", "action_label", "arrangement_label",
            "find_episode", "pattern_number", "play", "simulator_config"]

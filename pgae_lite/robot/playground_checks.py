@@ -56,6 +56,9 @@ def check_playground(models, cae, data, config, every, signal, arrangement, acti
     if normalise_signal(signal) not in signals:
         raise ArgumentError(f"signal {signal!r} is not offered here; the signals are: "
                             f"{', '.join(signals)}")
+    if not len(data):
+        raise ArgumentError("data holds no episodes: the playground needs a dataset with recordings to play, "
+                            "e.g. simulated_dataset('book')")
     recorded = sorted({pattern_parts(int(p))[1] for p in data.pattern})
     if arrangement is not None and arrangement_number(arrangement) not in recorded:
         raise ArgumentError(f"arrangement {arrangement} is not in this dataset; its "

@@ -17,7 +17,8 @@ from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.train.config import saved_model_config
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import CorruptCheckpointError, default_device, load_torch, save_torch
+from pgae_lite.util.storage import (CheckpointMismatchError, CorruptCheckpointError, default_device, load_torch,
+                                    save_torch)
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.
@@ -101,7 +102,13 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         raise CorruptCheckpointError(f"{path} holds non-finite weights (NaN or infinite) in {', '.join(broken[:3])}"
                                      f"{' ...' if len(broken) > 3 else ''}: the model cannot be used; train it again")
     model = build_pgae(saved_model_config(ckpt["profile"], path))
-    model.load_state_dict(ckpt["model"])
+    try:
+        model.load_state_dict(ckpt["model"])
+    except (RuntimeError, TypeError, AttributeError) as e:    # weights of another shape, another model's names
+        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
+        raise CheckpointMismatchError(f"{path} holds weights that do not fit the model its recipe describes "
+                                      f"({first[:160]}): it was written by another version of the package or "
+                                      "altered; train the model again") from None
     model.to(device or default_device()).eval()
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 

@@ -16,7 +16,7 @@ What several modules need and none of them owns. It imports nothing from
   with ``weights_only=True``; a write that fails (a full disk, a read-only
   folder) raises :class:`OutputError`, a damaged or unsafe file
   :class:`CorruptCheckpointError`, each one sentence naming the file;
-- :func:`folder_lock`: one training run at a time in an output folder;
+- :func:`folder_lock`: one training run at a time in an output folder (and what dead runs left, removed);
 - :class:`CheckpointMismatchError`: a file holds the work of another recipe.
 """
 from __future__ import annotations
@@ -27,6 +27,7 @@ import hashlib
 import json
 import os
 import pickle
+import re
 import shutil
 import socket
 import uuid
@@ -122,7 +123,8 @@ def _why(path: Path, error: BaseException) -> str:
     except OSError:
         free = None
     full = free is not None and free < 1 << 24                  # under 16 MiB left
-    if getattr(error, "errno", None) == errno.ENOSPC or full:
+    code = getattr(error, "errno", None)                       # an error without a code may be a full disk
+    if code == errno.ENOSPC or (full and code is None):
         return f"the disk is full ({free} bytes free)"
     if isinstance(error, OSError) and error.strerror:
         return error.strerror
@@ -236,6 +238,17 @@ def load_torch(path: str | Path, keys: tuple[str, ...] = (),
 LOCK_FILE = ".pgae_lite.lock"
 
 
+def _dead(pid: int) -> bool:
+    """Whether no process ``pid`` runs on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except PermissionError:
+        pass                          # alive, another user's
+    return False
+
+
 def _holder(lock: Path) -> str | None:
     """``host:pid`` of a lock's live holder; None if the lock is stale (or gone)."""
     try:
@@ -246,20 +259,32 @@ def _holder(lock: Path) -> str | None:
         return f"{host}:{pid}"        # another machine's process: it cannot be checked
     if not pid.isdigit() or int(pid) == os.getpid():
         return None                   # unreadable, or left by this very process
-    try:
-        os.kill(int(pid), 0)
-    except ProcessLookupError:
-        return None
-    except PermissionError:
-        pass                          # alive, another user's
-    return f"{host}:{pid}"
+    return None if _dead(int(pid)) else f"{host}:{pid}"
+
+
+# What a run leaves when it is killed: its lock's link source, a taken-over lock, half-written files.
+_LEFT_BEHIND = re.compile(rf"(?:{re.escape(LOCK_FILE)}|.+)\.(\d+)-[0-9a-f]{{8}}(?:\.tmp|\.stale)?")
+
+
+def clean_left_behind(folder: Path) -> list[Path]:
+    """Remove the lock and temporary files that dead processes left in ``folder`` (and below); the removed."""
+    removed = []
+    for path in folder.rglob("*"):
+        hit = _LEFT_BEHIND.fullmatch(path.name)
+        if hit and path.is_file() and not path.is_symlink() and int(hit.group(1)) != os.getpid() \
+                and _dead(int(hit.group(1))):
+            with contextlib.suppress(OSError):
+                path.unlink()
+                removed.append(path)
+    return removed
 
 
 @contextlib.contextmanager
 def folder_lock(folder: str | Path) -> Iterator[None]:
     """Hold ``folder``'s lock file while the block runs: a second run there fails.
 
-    The lock file holds ``host:pid``; a lock whose process has died is taken over.
+    The lock file holds ``host:pid``; a lock whose process has died is taken over, and the lock and
+    temporary files that dead runs left in the folder are removed (:func:`clean_left_behind`).
     """
     lock = make_folder(folder) / LOCK_FILE
     token = f"{socket.gethostname()}:{os.getpid()}"
@@ -288,6 +313,7 @@ def folder_lock(folder: str | Path) -> Iterator[None]:
     except BaseException:
         mine.unlink(missing_ok=True)
         raise
+    clean_left_behind(lock.parent)
     try:
         yield
     finally:
@@ -299,6 +325,6 @@ def folder_lock(folder: str | Path) -> Iterator[None]:
 
 __all__ = ["CACHE_ENV", "CheckpointMismatchError", "CorruptCheckpointError",
            "FolderBusyError", "OutputError", "array_digest", "atomic_path",
-           "atomic_write", "atomic_write_text", "cache_dir", "config_digest",
+           "atomic_write", "atomic_write_text", "cache_dir", "clean_left_behind", "config_digest",
            "default_device", "folder_lock", "load_torch", "make_folder", "save_torch",
            "training_threads", "TRAINING_THREADS"]

@@ -1,0 +1,172 @@
+"""What the robot will not do with a free instruction, and says instead (not in the paper).
+
+Paper, Sec. 3: PGAE-BERT "has the potential to recognise unseen natural language",
+and whatever it reads, it writes joints: it has no way to say no. "Don't push the
+red cube" is read as ``push red ...`` and executed. So, not in the paper, a free
+instruction is checked before the robot acts on it, from what the model
+understood of it and from the scene (the two cubes on the table):
+
+- its words as the model's language reads them: the text after the encoder's word
+  lookup (:mod:`pgae_lite.bert.word_lookup`), if it has one, and in it the phrases of the training
+  lexicon (:func:`pgae_lite.bert.phrasings.slot_meanings`): the actions, colours and
+  speeds it names;
+- the model's own readback (``repeat language``): the description it took the text to mean.
+
+Refused, with the reason in one sentence (:class:`CannotDo`):
+
+    negation        a negator (not, never, n't, no, stop, avoid, ...) whose clause goes on
+                    to name an action or a cube ("don't push the red cube"; a negated manner,
+                    "no rush", is only left out)
+    more than one   two actions (by their verbs), two cubes or two speeds named, or two sentences or steps
+                    ("..., then ...") that each name an action
+    absent cube     a colour named, or the readback's colour, that is not on the table
+    outside colour  a colour word (WordNet: a kind of colour) read as none of the world's six
+    outside action  no action of the world named at all (the verbs it names, if any, are said)
+
+The closed classes of words below are English grammar, written for this purpose; the
+rule reads the lexicon, WordNet and the scene, never a test sentence.
+"""
+from __future__ import annotations
+
+import itertools
+import re
+from dataclasses import replace
+from functools import lru_cache
+
+from pgae_lite.bert.phrase_lexicon import MEANINGS, PhraseLexicon, training_lexicon, words_of
+from pgae_lite.bert.phrasings import phrasings, slot_meanings
+from pgae_lite.bert.word_lookup import WordLookup, wordnet
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import COLOURS, LanguageError, parse_description
+
+#: Words that negate what follows them in their clause (and any word ending in n't).
+NEGATORS = frozenset("not never no nor neither nothing nobody stop avoid refrain dont cannot".split())
+#: Words that start a further step of a sequence.
+SEQUENCERS = frozenset("then afterwards afterward later next finally also".split())
+# A clause ends at punctuation or at a word that joins clauses.
+_CLAUSE_END = re.compile(r"[,.;:!?]|\b(?:and|but|or|then|while|before|after)\b", re.IGNORECASE)
+# A sentence or step ends at a full stop or semicolon, or where a sequencing word begins the next.
+_STEP_END = re.compile(r"[.;!?]|\b(?:" + "|".join(sorted(SEQUENCERS)) + r"|after that)\b", re.IGNORECASE)
+ACTIONS_SAID = "push (move up), pull (move down) or slide (move sideways) one cube"
+
+
+class CannotDo(LanguageError):
+    """A free instruction the robot will not act on; the message says why and what it can do."""
+
+
+@lru_cache(maxsize=1)
+def _words_only() -> WordLookup:
+    """A lookup that knows the training lexicon and its grammar's words (20 sentences of each meaning)."""
+    sentences = [t for meaning in itertools.product(*MEANINGS.values()) for t in phrasings(*meaning, 20)]
+    return WordLookup(training_lexicon(), sentences)
+
+
+def _reading(encoder, text: str) -> tuple[WordLookup, str, dict[str, str]]:
+    """(a lookup that knows the training words, the text as the encoder reads it, the words it replaced).
+
+    An encoder with its own word lookup reads the text through it; one without reads it as it is.
+    """
+    own = getattr(encoder, "word_lookup", None)
+    if own is None:
+        return _words_only(), text, {}
+    return own, own.rewrite(text), own.replacements(text)
+
+
+def _is_colour_word(word: str) -> bool:
+    """Whether WordNet lists ``word`` as a kind of colour (``black``, ``orange``), by any sense."""
+    colour = wordnet().synset("color.n.01")
+    return any(s == colour or colour in s.closure(lambda x: x.hypernyms()) for s in wordnet().synsets(word))
+
+
+def _negated(read: str, lexicon: PhraseLexicon) -> tuple[list[str], list[str]]:
+    """(the negations that name an action or a cube, the speeds negated) of the text ``read``."""
+    refused, speeds = [], []
+    for clause in _CLAUSE_END.split(read):
+        words = words_of(clause)
+        at = next((i for i, w in enumerate(words) if w in NEGATORS or w.endswith("n't")), None)
+        if at is None:
+            continue
+        scope = slot_meanings(" ".join(words[at + 1:]), lexicon)
+        if scope["action"] or scope["colour"]:
+            refused.append(" ".join(words[at:]))
+        speeds += scope["speed"]
+    return refused, speeds
+
+
+def _scene_text(scene: tuple[str, str]) -> str:
+    return f"the cubes here are {scene[0]} (left) and {scene[1]} (right)"
+
+
+def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood: str | None = None) -> str | None:
+    """Why the robot will not act on the free instruction ``text``, or None: it may.
+
+    ``encoder``: the model's language encoder (its word lookup, if it has one, reads the words);
+    ``scene``: the colours of the (left, right) cubes on the table, if known; ``understood``: the
+    model's readback of the text (``repeat language``), if known.
+    """
+    lookup, read, swapped = _reading(encoder, text)
+    lexicon = lookup.lexicon
+    negations, negated_speeds = _negated(read, lexicon)
+    if negations:
+        return (f"I can't do {text.strip()!r}: it says what not to do ({negations[0]!r}); tell me what to do, "
+                f"e.g. 'push the red cube slowly'")
+    said = slot_meanings(read, lexicon)
+    speeds = [s for s in said["speed"] if s not in negated_speeds]
+    steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
+    # Actions are counted by their verbs: a direction word may be a manner ("drag it right away").
+    by_verbs = slot_meanings(read, replace(lexicon, directions={a: () for a in lexicon.directions}))["action"]
+    several = [f"{len(set(v))} {slot}s ({', '.join(dict.fromkeys(v))})"
+               for slot, v in (("action", by_verbs), ("cube", said["colour"]), ("speed", speeds))
+               if len(set(v)) > 1]
+    if several or len(steps) > 1:
+        what = several[0] if several else f"{len(steps)} steps"
+        return f"one instruction at a time: {text.strip()!r} asks for {what}; tell me one action on one cube"
+    outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
+               and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and _is_colour_word(w)]
+    if outside:
+        return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
+                f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))
+    if not said["action"]:
+        verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w)
+                 and wordnet().synsets(w, pos="v")]
+        what = f"'{verbs[0]}' a cube" if verbs else f"do {text.strip()!r}"
+        return f"I can't {what}: I can {ACTIONS_SAID}"
+    if scene is None:
+        return None
+    for colour in dict.fromkeys(said["colour"]):
+        if colour not in scene:
+            word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
+            as_read = f" (I read '{word}' as {colour})" if word else ""
+            return f"there is no {colour} cube here{as_read}: {_scene_text(scene)}"
+    if understood is not None and not said["colour"]:     # the colour came from the transformer alone
+        try:
+            colour = parse_description(understood)[1]
+        except LanguageError:
+            return None
+        if colour not in scene:
+            return f"I understood {understood!r}, but there is no {colour} cube here: {_scene_text(scene)}"
+    return None
+
+
+def disagreement(understood: str | None, pattern: int) -> str | None:
+    """A sentence saying that the model's readback of a text and the episode ``pattern`` disagree, or None."""
+    p = Pattern.from_number(pattern)
+    chosen = f"the chosen episode is {p.action} {p.colour} {p.speed}: the verdict is against the chosen episode"
+    try:
+        meaning = parse_description(understood or "")
+    except LanguageError:
+        return f"I could not say the text back as a description ({understood or '<EOS>'!r}); {chosen}"
+    if meaning != (p.action, p.colour, p.speed):
+        return f"the text asks for {' '.join(meaning)}, as I understood it, but {chosen}"
+    return None
+
+
+def check_instruction(text: str, encoder, scene: tuple[str, str] | None = None,
+                      understood: str | None = None) -> None:
+    """Raise :class:`CannotDo` with :func:`refusal`'s reason if the robot will not act on ``text``."""
+    reason = refusal(text, encoder, scene, understood)
+    if reason:
+        raise CannotDo(reason)
+
+
+__all__ = ["ACTIONS_SAID", "NEGATORS", "SEQUENCERS", "CannotDo", "check_instruction", "disagreement", "refusal"]

