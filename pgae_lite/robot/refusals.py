@@ -109,7 +109,7 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
     negations, negated_speeds = _negated(read, lexicon)
     if negations:
         return (f"I can't do {text.strip()!r}: it says what not to do ({negations[0]!r}); tell me what to do, "
-                f"e.g. 'push the red cube slowly'")
+                f"e.g. 'push the {scene[0] if scene else 'red'} cube slowly'")
     said = slot_meanings(read, lexicon)
     speeds = [s for s in said["speed"] if s not in negated_speeds]
     steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
