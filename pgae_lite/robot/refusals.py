@@ -97,6 +97,53 @@ def _scene_text(scene: tuple[str, str]) -> str:
     return f"the cubes here are {scene[0]} (left) and {scene[1]} (right)"
 
 
+def _more_than_one(read: str, lexicon: PhraseLexicon, negated_speeds: list[str]) -> str | None:
+    """What makes ``read`` more than one instruction ("2 actions (push, pull)", "2 steps"), or None."""
+    said = slot_meanings(read, lexicon)
+    # Actions are counted by their verbs: a direction word may be a manner ("drag it right away").
+    by_verbs = slot_meanings(read, replace(lexicon, directions={a: () for a in lexicon.directions}))["action"]
+    speeds = [s for s in said["speed"] if s not in negated_speeds]
+    for slot, named in (("action", by_verbs), ("cube", said["colour"]), ("speed", speeds)):
+        if len(set(named)) > 1:
+            return f"{len(set(named))} {slot}s ({', '.join(dict.fromkeys(named))})"
+    steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
+    return f"{len(steps)} steps" if len(steps) > 1 else None
+
+
+def _outside_the_world(text: str, read: str, lookup: WordLookup, swapped: dict[str, str],
+                       scene: tuple[str, str] | None) -> str | None:
+    """A colour or an action the world does not have, said as what the robot can do; or None."""
+    outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
+               and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and _is_colour_word(w)]
+    if outside:
+        return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
+                f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))
+    if not slot_meanings(read, lookup.lexicon)["action"]:
+        verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w) and wordnet().synsets(w, pos="v")]
+        what = f"'{verbs[0]}' a cube" if verbs else f"do {text.strip()!r}"
+        return f"I can't {what}: I can {ACTIONS_SAID}"
+    return None
+
+
+def _absent_cube(read: str, lexicon: PhraseLexicon, swapped: dict[str, str], scene: tuple[str, str],
+                 understood: str | None) -> str | None:
+    """A cube named (or, where the words name none, understood) that is not on the table; or None."""
+    named = slot_meanings(read, lexicon)["colour"]
+    for colour in dict.fromkeys(named):
+        if colour not in scene:
+            word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
+            as_read = f" (I read '{word}' as {colour})" if word else ""
+            return f"there is no {colour} cube here{as_read}: {_scene_text(scene)}"
+    if understood is None or named:
+        return None
+    try:                                                  # the colour came from the transformer alone
+        colour = parse_description(understood)[1]
+    except LanguageError:
+        return None
+    return None if colour in scene else \
+        f"I understood {understood!r}, but there is no {colour} cube here: {_scene_text(scene)}"
+
+
 def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood: str | None = None) -> str | None:
     """Why the robot will not act on the free instruction ``text``, or None: it may.
 
@@ -105,47 +152,17 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
     model's readback of the text (``repeat language``), if known.
     """
     lookup, read, swapped = _reading(encoder, text)
-    lexicon = lookup.lexicon
-    negations, negated_speeds = _negated(read, lexicon)
+    negations, negated_speeds = _negated(read, lookup.lexicon)
     if negations:
         return (f"I can't do {text.strip()!r}: it says what not to do ({negations[0]!r}); tell me what to do, "
                 f"e.g. 'push the {scene[0] if scene else 'red'} cube slowly'")
-    said = slot_meanings(read, lexicon)
-    speeds = [s for s in said["speed"] if s not in negated_speeds]
-    steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
-    # Actions are counted by their verbs: a direction word may be a manner ("drag it right away").
-    by_verbs = slot_meanings(read, replace(lexicon, directions={a: () for a in lexicon.directions}))["action"]
-    several = [f"{len(set(v))} {slot}s ({', '.join(dict.fromkeys(v))})"
-               for slot, v in (("action", by_verbs), ("cube", said["colour"]), ("speed", speeds))
-               if len(set(v)) > 1]
-    if several or len(steps) > 1:
-        what = several[0] if several else f"{len(steps)} steps"
-        return f"one instruction at a time: {text.strip()!r} asks for {what}; tell me one action on one cube"
-    outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
-               and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and _is_colour_word(w)]
+    several = _more_than_one(read, lookup.lexicon, negated_speeds)
+    if several:
+        return f"one instruction at a time: {text.strip()!r} asks for {several}; tell me one action on one cube"
+    outside = _outside_the_world(text, read, lookup, swapped, scene)
     if outside:
-        return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
-                f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))
-    if not said["action"]:
-        verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w)
-                 and wordnet().synsets(w, pos="v")]
-        what = f"'{verbs[0]}' a cube" if verbs else f"do {text.strip()!r}"
-        return f"I can't {what}: I can {ACTIONS_SAID}"
-    if scene is None:
-        return None
-    for colour in dict.fromkeys(said["colour"]):
-        if colour not in scene:
-            word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
-            as_read = f" (I read '{word}' as {colour})" if word else ""
-            return f"there is no {colour} cube here{as_read}: {_scene_text(scene)}"
-    if understood is not None and not said["colour"]:     # the colour came from the transformer alone
-        try:
-            colour = parse_description(understood)[1]
-        except LanguageError:
-            return None
-        if colour not in scene:
-            return f"I understood {understood!r}, but there is no {colour} cube here: {_scene_text(scene)}"
-    return None
+        return outside
+    return None if scene is None else _absent_cube(read, lookup.lexicon, swapped, scene, understood)
 
 
 def disagreement(understood: str | None, pattern: int) -> str | None:
