@@ -1,0 +1,138 @@
+"""The robot says what it cannot do: how much of what it should refuse it refuses, and what it still executes.
+
+    python benchmarks/refusals.py [--profile book] [--training PGAE-BERT-phrasings] [--per-class 120]
+
+A set of sentences is generated here from a small grammar of its own (below; written for this
+measure from general English, not from the model's phrase lexicon), in five classes the robot
+must refuse, each told in a scene of two cubes (a random arrangement):
+
+- ``negation``: "don't push the red cube", "you must not drag the blue block", ...
+- ``more_than_one``: two instructions, "push the red cube, then pull the blue one", ...
+- ``absent_cube``: an instruction for a colour of the world that is not on the table;
+- ``outside_colour``: a colour the world does not have ("the orange cube", "the black box");
+- ``outside_action``: an action the robot cannot do ("lift", "rotate", "throw", ...);
+
+and one class it must act on, ``valid``: one instruction for a cube on the table. Each sentence
+is judged by :func:`pgae_lite.robot.refusals.refusal` with the trained free-form model's encoder
+and its readback of the sentence (``repeat language``, in an episode of the scene). Then the 108
+held-out paraphrases (``pgae_lite/bert/paraphrases.tsv``), as :func:`execute_paraphrases` tells
+them to the 216 test episodes: how many are still executed (the refusal must not cost them).
+Writes results/refusals.json: per class, the share refused, and examples of each outcome.
+"""
+from __future__ import annotations
+
+import random
+
+from harness import Benchmark
+
+from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.robot.closedloop import variation_of
+from pgae_lite.robot.instructions import paraphrase_of, say_back, scene_of
+from pgae_lite.robot.refusals import refusal
+from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.runs.trainings import by_name
+from pgae_lite.world.patterns import ARRANGEMENTS, pattern_parts
+from pgae_lite.world.words import COLOURS
+
+# The grammar: verbs "{}" around the object, by action; objects; manners; openings.
+VERBS = {"push": ("push {}", "shove {}", "poke {} away", "move {} away from you", "nudge {} forward",
+                  "knock {} forward", "send {} away"),
+         "pull": ("pull {}", "drag {}", "bring {} back toward you", "haul {} closer", "yank {} back",
+                  "draw {} in", "move {} nearer to you"),
+         "slide": ("slide {}", "move {} to the side", "scoot {} sideways", "slide {} across", "shift {} aside",
+                   "glide {} over")}
+GERUNDS = {"push": "pushing {}", "pull": "pulling {}", "slide": "sliding {}"}
+OBJECTS = ("the {} cube", "the {} block", "that {} one", "the {} box", "the {} thing")
+MANNERS = ("", "slowly", "quickly", "fast", "gently", "in a hurry", "carefully", "at a snail's pace",
+           "right away", "with a bit of speed")
+OPENINGS = ("", "please ", "could you ", "now ", "I'd like you to ", "robot, ", "go on and ")
+NEGATIONS = ("don't {v}", "do not {v}", "never {v}", "please don't {v}", "you must not {v}", "stop {g}",
+             "avoid {g}", "I don't want you to {v}", "no, don't {v}", "do not ever {v}")
+SEQUENCES = ("{a} and then {b}", "{a}, then {b}", "first {a}, after that {b}", "{a} and {b}", "{a}. {b} too",
+             "{a}; afterwards {b}")
+OUTSIDE_COLOURS = ("orange", "pink", "brown", "black", "white", "grey", "beige", "silver", "tan", "ivory",
+                   "bronze", "khaki")
+OUTSIDE_ACTIONS = ("lift {}", "rotate {}", "throw {}", "stack {}", "spin {}", "flip {} over", "grab {}",
+                   "pick up {}", "knock {} over", "squeeze {}", "paint {}", "turn {} around", "hide {}",
+                   "open {}", "smash {}")
+CLASSES = ("negation", "more_than_one", "absent_cube", "outside_colour", "outside_action", "valid")
+
+
+def sentence(kind: str, scene: tuple[str, str], rng: random.Random) -> str:
+    """One sentence of class ``kind`` for a table with the cubes ``scene``."""
+    here = rng.choice(scene)
+    action = rng.choice(tuple(VERBS))
+    obj = rng.choice(OBJECTS).format(here)
+    manner = rng.choice(MANNERS)
+
+    def said(verb: str, thing: str) -> str:
+        return f"{verb.format(thing)} {manner}".strip()
+
+    if kind == "negation":
+        text = rng.choice(NEGATIONS).format(v=said(rng.choice(VERBS[action]), obj),
+                                            g=said(GERUNDS[action], obj))
+    elif kind == "more_than_one":
+        other = rng.choice([a for a in VERBS if a != action] + [action])
+        second = rng.choice(OBJECTS).format(scene[1] if here == scene[0] else scene[0])
+        text = rng.choice(SEQUENCES).format(a=said(rng.choice(VERBS[action]), obj),
+                                            b=said(rng.choice(VERBS[other]), second))
+    elif kind == "absent_cube":
+        text = said(rng.choice(VERBS[action]), rng.choice(OBJECTS).format(
+            rng.choice([c for c in COLOURS if c not in scene])))
+    elif kind == "outside_colour":
+        text = said(rng.choice(VERBS[action]), rng.choice(OBJECTS).format(rng.choice(OUTSIDE_COLOURS)))
+    elif kind == "outside_action":
+        text = said(rng.choice(OUTSIDE_ACTIONS), obj)
+    else:
+        text = said(rng.choice(VERBS[action]), obj)
+    return rng.choice(OPENINGS) + text
+
+
+def main() -> None:
+    bench = Benchmark("refusals", __doc__)
+    bench.parser.add_argument("--training", default="PGAE-BERT-phrasings", help="the free-form model")
+    bench.parser.add_argument("--per-class", type=int, default=120, help="sentences per class")
+    args = bench.parse()
+    data = simulated_dataset(args.profile, "cpu", progress=False)
+    model = trained_pgae(by_name(args.training), args.profile, args.seeds[0], device="cpu", progress=False)
+    encoder, test = model.model.language_encoder, data.split("test")
+    rng = random.Random(args.seeds[0])
+
+    arrangements = sorted({pattern_parts(int(p))[1] for p in test.pattern})
+    rows_of = {a: [i for i, p in enumerate(test.pattern) if pattern_parts(int(p))[1] == a] for a in arrangements}
+    told, rows = [], []                                      # (class, text, arrangement), an episode of its scene
+    for kind in CLASSES:
+        for _ in range(args.per_class):
+            arrangement = rng.choice(arrangements)
+            told.append((kind, sentence(kind, ARRANGEMENTS[arrangement], rng), arrangement))
+            rows.append(rng.choice(rows_of[arrangement]))
+    understood = say_back(model.model, test.subset(rows), model.normaliser, [t for _, t, _ in told])
+    classes = {}
+    for kind in CLASSES:
+        judged = [(text, back, refusal(text, encoder, ARRANGEMENTS[a], back))
+                  for (k, text, a), back in zip(told, understood) if k == kind]
+        refused = [j for j in judged if j[2]]
+        kept = [j for j in judged if not j[2]]
+        classes[kind] = {"sentences": len(judged), "refused": len(refused),
+                         "refused_%": round(100 * len(refused) / len(judged), 1),
+                         "refused_examples": [{"told": t, "said": r} for t, _, r in refused[:4]],
+                         "acted_on_examples": [{"told": t, "understood": b} for t, b, _ in kept[:6]]}
+        print(kind, classes[kind]["refused_%"], flush=True)
+
+    paraphrases = load_paraphrases()
+    episodes = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
+    backs = say_back(model.model, test, model.normaliser, [p.text for p in episodes])
+    refused = [(p.text, r) for p, pattern, back in zip(episodes, test.pattern, backs)
+               if (r := refusal(p.text, encoder, scene_of(int(pattern)), back))]
+    executed = len(episodes) - len(refused)
+    bench.write({"training": args.training, "classes": classes,
+                 "should_refuse_%": round(100 * sum(c["refused"] for k, c in classes.items() if k != "valid")
+                                          / sum(c["sentences"] for k, c in classes.items() if k != "valid"), 1),
+                 "paraphrases": {"texts": len(paraphrases), "episodes": len(episodes), "executed": executed,
+                                 "executed_%": round(100 * executed / len(episodes), 1),
+                                 "refused_examples": [{"told": t, "said": r} for t, r in refused[:6]]}})
+    print(bench.path)
+
+
+if __name__ == "__main__":
+    main()
