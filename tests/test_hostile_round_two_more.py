@@ -125,3 +125,48 @@ def test_an_exercise_check_refuses_a_seed_that_is_not_one(seed, error):
         check_peephole_step(lambda x, state, cell: state, seed=seed)
     with pytest.raises(error, match="seed must be a whole number"):
         check_gmu(lambda *a: None, seed=seed)
+
+
+# --------------------------------------------------------------------------- result files
+def _damaged(tmp_path, monkeypatch, change) -> None:
+    import json
+
+    from pgae_lite.runs.results import RESULTS_ENV, repository
+
+    result = json.loads((repository() / "results" / "table1-original.json").read_text())
+    text = change(result)
+    path = tmp_path / "table1-original.json"
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text if isinstance(text, str) else json.dumps(result))
+    monkeypatch.setenv(RESULTS_ENV, str(tmp_path))
+
+
+def _first_row(result) -> dict:
+    return next(iter(result["data"]["rows"].values()))
+
+
+@pytest.mark.parametrize("change, says", [
+    (lambda r: _first_row(r)["stats"]["describe"]["accuracy"].update(median=float("nan")), "must be a finite number"),
+    (lambda r: r["data"]["rows"].update({"X |\n<script>alert(1)</script>": _first_row(r)}),
+     "is not a row of Table 1"),
+    (lambda r: r.update(command="python x.py <!-- headline:end -->"), "command holds markup"),
+    (lambda r: r.update(seeds="012"), "seeds must be a list of whole numbers"),
+    (lambda r: _first_row(r)["stats"].pop("execute"), "lacks the execute nrmse median"),
+    (lambda r: '{"data": {"rows": ', "is not valid JSON"),
+    (lambda r: bytes(range(128, 256)), "is not text"),
+    (lambda r: "[1, 2]", "is not a result file"),
+])
+def test_a_damaged_or_hostile_result_file_is_refused_before_it_is_rendered(tmp_path, monkeypatch, change, says):
+    from pgae_lite.runs.results import ResultFileError, headline_table
+
+    _damaged(tmp_path, monkeypatch, change)
+    with pytest.raises(ResultFileError, match=says):
+        headline_table()
+
+
+def test_the_committed_result_renders_as_before():
+    from pgae_lite.runs.results import headline_table, repository
+
+    assert headline_table() in (repository() / "README.md").read_text()

@@ -22,11 +22,14 @@ does not have. Superseded files lie in ``results/history/`` and are named ``hist
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 from pathlib import Path
 
 import pandas as pd
 
+from pgae_lite.config import ROWS
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.util.storage import atomic_write_text
 from pgae_lite.world.words import TEST_SIGNALS
@@ -37,6 +40,39 @@ REPOSITORY_ENV = "PGAE_LITE_REPOSITORY"    # the repository's root
 
 class RepositoryNotFoundError(PGAELiteError, FileNotFoundError):
     """No repository (a folder holding ``results/`` and ``_toc.yml``) where it was looked for."""
+
+
+class ResultFileError(PGAELiteError, ValueError):
+    """A result file that is damaged, or holds what must not be rendered (one sentence naming the file)."""
+
+
+# Text rendered into Markdown or HTML: no table cell separator, no tag, no line break, no generated-block marker.
+_MARKUP = re.compile(r"[|<>\n\r`]|<!--|-->")
+
+
+def text_of(value, where: str) -> str:
+    """``value`` when it is a string that renders as itself in Markdown; else a :class:`ResultFileError`."""
+    if not isinstance(value, str):
+        raise ResultFileError(f"{where} must be a string; got {type(value).__name__} {value!r:.60}")
+    if _MARKUP.search(value):
+        raise ResultFileError(f"{where} holds markup ({_MARKUP.search(value).group(0)!r}: a table separator, tag, "
+                              f"backquote or line break), which would not render as itself; got {value!r:.80}")
+    return value
+
+
+def number_of(value, where: str) -> float:
+    """``value`` when it is a finite number (not a bool); else a :class:`ResultFileError`."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ResultFileError(f"{where} must be a finite number; got {value!r:.60}")
+    return float(value)
+
+
+def seeds_of(value, where: str) -> list[int]:
+    """``value`` when it is a non-empty list of whole numbers >= 0; else a :class:`ResultFileError`."""
+    if not isinstance(value, list) or not value or \
+            not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value):
+        raise ResultFileError(f"{where} must be a list of whole numbers >= 0 (the seeds); got {value!r:.60}")
+    return value
 
 
 def repository(root: str | Path | None = None) -> Path:
@@ -77,7 +113,17 @@ def load(name: str) -> dict:
     if not path.is_file():
         raise FileNotFoundError(f"no result file {path}; the result files are: {', '.join(names()) or 'none'} "
                                 f"(set {RESULTS_ENV} to the folder that holds them)")
-    return json.loads(path.read_text())
+    try:
+        result = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise ResultFileError(f"{path} is not text (UTF-8): a result file is JSON; write it again") from None
+    except json.JSONDecodeError as e:
+        raise ResultFileError(f"{path} is not valid JSON (line {e.lineno}, column {e.colno}: {e.msg}); "
+                              "write it again with its benchmark") from None
+    if not isinstance(result, dict) or not isinstance(result.get("data"), dict):
+        raise ResultFileError(f"{path} is not a result file: it must be a JSON object with a 'data' object "
+                              "(benchmarks/harness.py writes them)")
+    return result
 
 
 def value(name: str, *keys: str | int):
@@ -102,12 +148,23 @@ def measured(name: str) -> str:
     """When, where and how a result file was made, as one line of text."""
     r = load(name)
     m = r.get("machine", {})
+    if not isinstance(m, dict):
+        raise ResultFileError(f"{name}.json: machine must be an object; got {m!r:.60}")
+    said = {}
+    for key in ("cpu", "cores", "torch", "threads"):
+        v = m.get(key, "?")
+        said[key] = str(v) if isinstance(v, int) and not isinstance(v, bool) else \
+            text_of(v, f"{name}.json: machine.{key}")
     threads = m.get("threads", "?")
-    where = f"{m.get('cpu', '?')}, {m.get('cores', '?')} cores, {threads} thread{'' if threads == 1 else 's'}"
+    where = f"{said['cpu']}, {said['cores']} cores, {said['threads']} thread{'' if threads == 1 else 's'}"
     if m.get("gpu"):
-        where += f", {m['gpu']}"
-    return (f"measured {r['date'][:10]} at commit {r['commit']} ({where}, torch {m.get('torch', '?')}, "
-            f"profile {r.get('profile')}, seeds {r.get('seeds')}) by `{r['command']}`")
+        where += f", {text_of(m['gpu'], f'{name}.json: machine.gpu')}"
+    seeds = r.get("seeds")
+    seeds = seeds if seeds is None else seeds_of(seeds, f"{name}.json: seeds")
+    profile = r.get("profile") if r.get("profile") is None else text_of(r["profile"], f"{name}.json: profile")
+    return (f"measured {text_of(r.get('date'), f'{name}.json: date')[:10]} at commit "
+            f"{text_of(r.get('commit'), f'{name}.json: commit')} ({where}, torch {said['torch']}, "
+            f"profile {profile}, seeds {seeds}) by `{text_of(r.get('command'), f'{name}.json: command')}`")
 
 
 def table1_frame(name: str, rows: list[str] | None = None) -> pd.DataFrame:
@@ -149,12 +206,21 @@ def headline_table() -> str:
             "|---|---|---|---|---|")
     lines = [head]
     for row, r in data.items():
-        stats, paper = r["stats"], r["paper"]
-        lines.append(f"| {row} | {stats['describe']['accuracy']['median']:.2f} ({paper['describe'][0]:.2f}) "
-                     f"| {stats['repeat language']['accuracy']['median']:.2f} ({paper['repeat language'][0]:.2f}) "
-                     f"| {stats['execute']['nrmse']['median']:.3f} ({paper['execute'][1]:.2f}) "
-                     f"| {stats['repeat action']['nrmse']['median']:.3f} ({paper['repeat action'][1]:.2f}) |")
-    seeds = load("table1-original")["seeds"]
+        if row not in ROWS:
+            raise ResultFileError(f"table1-original.json: row {row!r:.60} is not a row of Table 1; the rows "
+                                  f"are: {', '.join(ROWS)}")
+        cells = []
+        for signal, key, digits in (("describe", "accuracy", 2), ("repeat language", "accuracy", 2),
+                                    ("execute", "nrmse", 3), ("repeat action", "nrmse", 3)):
+            where = f"table1-original.json: rows[{row!r}]"
+            try:
+                ours, paper = r["stats"][signal][key]["median"], r["paper"][signal][0 if key == "accuracy" else 1]
+            except (KeyError, IndexError, TypeError):
+                raise ResultFileError(f"{where} lacks the {signal} {key} median or the paper's figure") from None
+            cells.append(f"{number_of(ours, f'{where} {signal} {key} median'):.{digits}f} "
+                         f"({number_of(paper, f'{where} paper {signal}'):.2f})")
+        lines.append(f"| {row} | " + " | ".join(cells) + " |")
+    seeds = seeds_of(load("table1-original").get("seeds"), "table1-original.json: seeds")
     lines.append(f"\nMedian over seeds {', '.join(map(str, seeds))} (the paper's figure in brackets); "
                  f"{measured('table1-original')}.")
     return "\n".join(lines)
