@@ -170,3 +170,26 @@ def test_the_committed_result_renders_as_before():
     from pgae_lite.runs.results import headline_table, repository
 
     assert headline_table() in (repository() / "README.md").read_text()
+
+
+# --------------------------------------------------------------------------- the features cache
+def test_a_features_cache_holding_other_data_is_not_used(tmp_path, monkeypatch, smoke_episodes, toy):
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.pipeline import _stem, simulated_dataset, trained_cae
+    from pgae_lite.util.storage import CACHE_ENV, cache_dir, config_digest
+
+    simulated_dataset("smoke", "cpu", progress=False)           # the shared cache: episodes, CAE, features
+    trained_cae("smoke", "cpu", progress=False)
+    for part in ("episodes", "cae"):
+        shutil.copytree(cache_dir() / part, tmp_path / part)
+    monkeypatch.setenv(CACHE_ENV, str(tmp_path))
+    prof = get_profile("smoke")
+    path = tmp_path / "features" / f"{_stem(prof.data, prof.cae)}.npz"
+    path.parent.mkdir()
+    # Other data under the cache's name, stamped with the name and with the configs' digest itself:
+    for stamp in (path.stem, config_digest({"data": prof.data.to_dict(), "cae": prof.cae.to_dict()})):
+        toy.save(path, fingerprint=stamp)
+        with pytest.warns(UserWarning, match="computing the features again"):
+            data = simulated_dataset("smoke", "cpu", progress=False)
+        assert data.source == f"simulated:{prof.data.key()}" and len(data) != len(toy)
+    assert simulated_dataset("smoke", "cpu", progress=False).source == data.source   # now the cache is used

@@ -42,7 +42,8 @@ from tqdm.auto import tqdm
 from pgae_lite.data.dataset import PGAEDataset, from_recordings
 from pgae_lite.sim.record import Episode, SimConfig, record_episode
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import array_digest, atomic_write, atomic_write_text, cache_dir, config_digest
+from pgae_lite.util.storage import (array_digest, atomic_write, atomic_write_text, cache_dir, config_digest,
+                                    make_folder)
 from pgae_lite.world.colours import DEFAULT_WORLD, World
 
 #: Bump when the simulator changes what it records: old caches are then not reused.
@@ -212,7 +213,7 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
     config = config or DatasetConfig()          # the book's (its profiles: pgae_lite.config)
     t0 = time.perf_counter()
     folder = episode_folder(config)
-    folder.mkdir(parents=True, exist_ok=True)
+    make_folder(folder)
     _write_json(folder / "config.json",
                 {"version": GENERATOR_VERSION, **config.to_dict()})
     manifest = _read_manifest(folder)

@@ -107,7 +107,9 @@ def extended_dataset(world: World, profile: Profile | str | None = None,
               ep.joints, features(ep.images), features(ep.images_opposite))
              for ep in episodes), source=f"simulated:{prof.data.key()}+{new.key()}")
     path = cache_dir() / "features" / f"{_stem(world, prof)}.npz"
-    return cached_dataset(path, make)
+    ids = [f"sim/{episode_name(p, v)}" for config in (prof.data, new) for p, v in config.episodes()]
+    return cached_dataset(path, make, {"data": prof.data.to_dict(), "new": new.to_dict(), "cae": prof.cae.to_dict()},
+                          f"simulated:{prof.data.key()}+{new.key()}", ids)
 
 
 def pgae_folder(world: World, profile: Profile | str | None = None, seed: int = 0,

@@ -30,8 +30,8 @@ from pgae_lite.bert.phrasings import phrasings_digest
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from pgae_lite.config import Profile, Training, as_training, get_profile, training_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
-from pgae_lite.data.simulated import DatasetConfig, generate, to_dataset, training_frames
-from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest
+from pgae_lite.data.simulated import DatasetConfig, episode_name, generate, to_dataset, training_frames
+from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest, make_folder
 
 if TYPE_CHECKING:
     from pgae_lite.train.loop import Trained
@@ -90,19 +90,44 @@ def simulated_dataset(profile: Profile | str | None = None, device: str | None =
         model, _ = trained_cae(prof, device, progress, workers)
         return to_dataset(data, lambda frames: extract_features(model, frames),
                           progress)
-    return cached_dataset(path, make)
+    return cached_dataset(path, make, {"data": data.to_dict(), "cae": cae_config.to_dict()},
+                          f"simulated:{data.key()}", [f"sim/{episode_name(p, v)}" for p, v in data.episodes()])
 
 
-def cached_dataset(path: Path, make: Callable[[], PGAEDataset]) -> PGAEDataset:
-    """The dataset cached at ``path``, else ``make()``'s, saved there."""
-    if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite
+def made_otherwise(dataset: PGAEDataset, source: str, ids: list[str]) -> str | None:
+    """How ``dataset`` differs from the recordings ``ids`` of ``source`` it should hold, or None."""
+    if dataset.source != source:
+        return f"it holds data of {dataset.source!r}, not of {source!r}"
+    if sorted(map(str, dataset.ids)) != sorted(ids):
+        return f"it holds {len(dataset)} episodes, not the {len(ids)} recorded ones"
+    return None
+
+
+def cached_dataset(path: Path, make: Callable[[], PGAEDataset], configs: dict, source: str,
+                   ids: list[str]) -> PGAEDataset:
+    """The dataset cached at ``path``, else ``make()``'s, saved there.
+
+    A cached file is used only if its fingerprint is the digest of ``configs`` (those that make
+    the data, not the file's name), its arrays match their saved digest, and its content is what
+    the configs make: data of ``source``, the episodes ``ids``. Else it is made again.
+    """
+    fingerprint = config_digest(configs)
+    if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite, the content
         try:
-            return PGAEDataset.load(path, fingerprint=path.stem)
+            dataset = PGAEDataset.load(path, fingerprint=fingerprint)
+            problem = made_otherwise(dataset, source, ids)
+            if problem is None:
+                return dataset
+            warnings.warn(f"{path}: not this cache's data ({problem}); computing the features again",
+                          stacklevel=2)
         except DataFormatError as e:
             warnings.warn(f"{e}; computing the features again", stacklevel=2)
     dataset = make()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    dataset.save(path, fingerprint=path.stem)
+    problem = made_otherwise(dataset, source, ids)
+    if problem is not None:
+        raise DataFormatError(f"the features made for {path} are not what the configs describe: {problem}")
+    make_folder(path.parent)
+    dataset.save(path, fingerprint=fingerprint)
     return dataset
 
 
@@ -209,4 +234,4 @@ def _finished(training: Training, profile: Profile, seed: int) -> bool:
 
 
 __all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "cae_path", "cached_cae",
-           "cached_dataset"]
+           "cached_dataset", "made_otherwise"]
