@@ -3,6 +3,7 @@ reason now gets one sentence, and what a killed run leaves behind is cleaned (ea
 from __future__ import annotations
 
 import importlib.util
+import math
 import os
 import shutil
 import subprocess
@@ -193,3 +194,71 @@ def test_a_features_cache_holding_other_data_is_not_used(tmp_path, monkeypatch, 
             data = simulated_dataset("smoke", "cpu", progress=False)
         assert data.source == f"simulated:{prof.data.key()}" and len(data) != len(toy)
     assert simulated_dataset("smoke", "cpu", progress=False).source == data.source   # now the cache is used
+
+
+# --------------------------------------------------------------------------- worlds, words, the authors' files
+def test_with_colour_refuses_a_colour_the_camera_cannot_tell_apart():
+    from pgae_lite.exercises.world import check_colour
+    from pgae_lite.world.colours import CUBE_RGBA, TABLE_RGBA, with_colour
+
+    for rgba, near in ((CUBE_RGBA["red"], "the red cube"), (TABLE_RGBA, "the table"),
+                       ((0.90, 0.12, 0.10, 1.0), "the red cube")):
+        with pytest.raises(ValueError, match=f"too close to {near} for the camera"):
+            with_colour("orange", "amber", rgba)
+        assert not check_colour("orange", rgba)                          # the exercise's rule: the same
+    world = with_colour("orange", "amber", (0.98, 0.50, 0.05, 1.0))
+    with pytest.raises(ValueError, match="too close to the orange cube"):
+        with_colour("pink", "rose", (0.98, 0.50, 0.05, 1.0), world=world)
+    assert check_colour("orange", (0.98, 0.50, 0.05, 1.0))
+
+
+def test_decode_refuses_rows_that_choose_no_word():
+    from pgae_lite.world.words import VOCABULARY, decode
+
+    scores = torch.zeros(5, len(VOCABULARY))
+    with pytest.raises(LanguageError, match="row 0 chooses no word"):
+        decode(scores)
+    scores[0, 14] = 1.0                                                   # push, then a row of zeros
+    with pytest.raises(LanguageError, match="row 1 chooses no word"):
+        decode(scores)
+    scores[1, 0] = 1.0                                                    # push <EOS>; later rows are not read
+    assert decode(scores) == "push"
+    scores[0, 3] = math.nan
+    with pytest.raises(LanguageError, match="row 0 holds a value that is not finite"):
+        decode(scores)
+
+
+@pytest.mark.parametrize("line, says", [("XYZZY train", "'XYZZY' 'train' is not an action of the world"),
+                                        ("\U0001f642 test", "is not an action of the world"),
+                                        ("PUSH-L-SLOW maybe", "'maybe' is not an action")])
+def test_the_authors_action_labels_are_checked(tmp_path, line, says):
+    from pgae_lite.data.dataset import DataFormatError
+    from pgae_lite.data.original import _read_patterns
+
+    (tmp_path / "actions.txt").write_text(f"PUSH-L-SLOW train\n{line}\n", encoding="utf-8")
+    (tmp_path / "arrangements.txt").write_text("red+blue\nred+blue\n")
+    with pytest.raises(DataFormatError, match=f"actions.txt, entry 2: .*{says}"):
+        _read_patterns(tmp_path)
+    (tmp_path / "actions.txt").write_text("PUSH-L-SLOW train\nPULL-R-FAST test\n")
+    (tmp_path / "arrangements.txt").write_text("red+blue\nred+orange\n")
+    with pytest.raises(DataFormatError, match="arrangements.txt, entry 2: 'red\\+orange' is not two colours"):
+        _read_patterns(tmp_path)
+
+
+def test_a_file_of_random_bytes_is_named(tmp_path):
+    from pgae_lite.data.checks import read_rows
+    from pgae_lite.data.dataset import DataFormatError
+
+    path = tmp_path / "target000000.txt"
+    path.write_bytes(bytes(range(128, 256)) * 8)
+    with pytest.raises(DataFormatError, match="target000000.txt is not a text file"):
+        read_rows(path, 5)
+
+
+def test_a_dataset_without_test_samples_is_refused_before_any_training(tmp_path, toy):
+    from pgae_lite.data.dataset import DataFormatError
+    from pgae_lite.runs.reproduce import run_table1
+
+    with pytest.raises(DataFormatError, match="has no test samples"):
+        run_table1(toy.subset(~toy.is_test), ["PGAE"], [0], tmp_path / "out", get_profile("smoke"), "cpu", False)
+    assert not (tmp_path / "out").exists()                                # nothing trained, nothing written

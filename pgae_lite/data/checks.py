@@ -28,6 +28,15 @@ JOINT_BOUNDS = (-1.0, 2.0)
 VISION_LIMIT = 1000.0
 
 
+def text_of(path: Path) -> str:
+    """The text of ``path``; :class:`~pgae_lite.data.dataset.DataFormatError` naming it if it is not text."""
+    try:
+        return path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise DataFormatError(f"{path} is not a text file (byte {e.start} is not UTF-8): the authors' files "
+                              "are plain text, numbers and words") from None
+
+
 def read_rows(path: Path, width: int) -> np.ndarray:
     """The numbers of a text file, ``width`` per row, as float32 (rows, width).
 
@@ -38,7 +47,7 @@ def read_rows(path: Path, width: int) -> np.ndarray:
         raise DataFormatError(f"missing file {path}: every sample needs the same file "
                               "name in all sub-folders")
     lines, fields = [], []
-    for number, line in enumerate(path.read_text().splitlines(), 1):
+    for number, line in enumerate(text_of(path).splitlines(), 1):
         row = line.split()
         if not row:
             continue
@@ -82,7 +91,7 @@ def _first(bad: np.ndarray, lines: list[int]) -> tuple[int, int]:
 
 def _lines(path: Path) -> list[int]:
     """Numbers of the non-blank lines of ``path`` (read again only on an error)."""
-    lines = path.read_text().splitlines()
+    lines = text_of(path).splitlines()
     return [n for n, line in enumerate(lines, 1) if line.strip()]
 
 
@@ -112,7 +121,7 @@ def check_vocabulary(root: Path) -> None:
     if not path.is_file():
         raise DataFormatError(f"missing {path} (the words and signals in index order, "
                               "from the authors' repository)")
-    found = [line.strip() for line in path.read_text().splitlines() if line.strip()]
+    found = [line.strip() for line in text_of(path).splitlines() if line.strip()]
     expected = [*VOCABULARY, *(f"{s}:" for s in SIGNALS)]
     if found != expected:
         i = next((i for i, (a, b) in enumerate(zip(found, expected)) if a != b),
@@ -124,5 +133,5 @@ def check_vocabulary(root: Path) -> None:
                               f"{len(SIGNALS)} signals in pgae_lite.world.words's order")
 
 
-__all__ = ["JOINT_BOUNDS", "VISION_LIMIT", "read_rows", "check_range", "check_one_hot",
+__all__ = ["JOINT_BOUNDS", "VISION_LIMIT", "read_rows", "text_of", "check_range", "check_one_hot",
            "check_vocabulary"]

@@ -16,10 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from pgae_lite.data.checks import JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range, check_vocabulary, read_rows
+from pgae_lite.data.checks import (JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range, check_vocabulary,
+                                   read_rows, text_of)
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.world.patterns import MAX_STEPS, Pattern
-from pgae_lite.world.words import VOCABULARY
+from pgae_lite.world.words import COLOURS, VOCABULARY
 
 _SUBTREES = ("behavior", "vision", "vision_opp", "language")
 
@@ -123,11 +124,21 @@ def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:
     for f in (actions_file, arrangements_file):
         if not f.is_file():
             raise DataFormatError(f"missing {f} (one line per pattern, from the authors' repository)")
-    actions = [line.split() for line in actions_file.read_text().splitlines() if line.strip()]
-    arrangements = [line.strip() for line in arrangements_file.read_text().splitlines() if line.strip()]
+    actions = [line.split() for line in text_of(actions_file).splitlines() if line.strip()]
+    arrangements = [line.strip() for line in text_of(arrangements_file).splitlines() if line.strip()]
     if len(actions) != len(arrangements) or any(len(a) != 2 for a in actions):
         raise DataFormatError(f"{actions_file} must have 'ACTION-CUBE-SPEED train|test' per line, "
                               f"as many lines as {arrangements_file}")
+    labels = [f"{a}-{side}-{speed}" for a in ("PUSH", "PULL", "SLIDE") for side in "LR" for speed in ("SLOW", "FAST")]
+    for line, (label, split) in enumerate(actions, 1):
+        if label not in labels or split not in ("train", "test"):
+            raise DataFormatError(f"{actions_file}, entry {line}: {label!r:.40} {split!r:.20} is not an "
+                                  f"action of the world and a split; the actions are {', '.join(labels)}, the "
+                                  "splits train and test")
+    for line, arrangement in enumerate(arrangements, 1):
+        if not all(c in COLOURS for c in arrangement.split("+")) or arrangement.count("+") != 1:
+            raise DataFormatError(f"{arrangements_file}, entry {line}: {arrangement!r:.40} is not two "
+                                  f"colours of the world joined by '+'; the colours are {', '.join(COLOURS)}")
     return {i: (a[0], arr, a[1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
 
 

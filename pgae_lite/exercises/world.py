@@ -16,7 +16,7 @@ import numpy as np
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.evaluate import nrmse, predict
 from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
-from pgae_lite.world.colours import World
+from pgae_lite.world.colours import CUBE_RGBA, MIN_COLOUR_DIFFERENCE, TABLE_RGBA, World, nearest_colour
 from pgae_lite.exercises.result import RAISED, CheckResult, _call, _numbers
 
 #: Describe accuracy (%) on the held-out episodes that move the new colour's cube.
@@ -58,14 +58,12 @@ def check_vocabulary(words: Sequence[str], new: Sequence[str] = ()) -> CheckResu
     return result
 
 
-def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
+def check_colour(name: str, rgba: Sequence[float], min_difference: float = MIN_COLOUR_DIFFERENCE,
                  world: World | None = None) -> CheckResult:
     """(f) A new cube colour: one lowercase word and an opaque RGBA in [0, 1] that the camera can tell
     apart from the other cubes and the table (some channel differs by ``min_difference`` or more).
 
     ``world``: compare with its colours too (:func:`pgae_lite.world.colours.with_colour`)."""
-    from pgae_lite.sim.scene import CUBE_RGBA, TABLE_RGBA  # here: pybullet loads only when needed
-
     colours = world.lexicon.colours if world is not None else COLOURS
     rgbas = {**CUBE_RGBA, **(world.rgba if world is not None else {})}
 
@@ -90,14 +88,13 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = 0.2,
         return result
     others = {**{f"the {c} cube": v for c, v in rgbas.items() if c != name},
               "the table": TABLE_RGBA}
-    gaps = {o: max(abs(a - b) for a, b in zip(values, v[:3])) for o, v in others.items()}
-    closest = min(gaps, key=gaps.get)
-    if gaps[closest] < min_difference:
-        result.fail(f"too close to {closest}: no colour channel differs by more than {gaps[closest]:.2f}",
+    closest, gap = nearest_colour(values, others)          # the rule with_colour applies too
+    if gap < min_difference:
+        result.fail(f"too close to {closest}: no colour channel differs by more than {gap:.2f}",
                     f"the CAE sees R, G and B separately: make one channel differ by {min_difference} or more")
     else:
         result.ok(f"a valid opaque RGBA; the nearest is {closest}, "
-                  f"{gaps[closest]:.2f} apart in the most different channel")
+                  f"{gap:.2f} apart in the most different channel")
     return result
 
 

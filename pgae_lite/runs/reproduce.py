@@ -156,6 +156,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
                profile: Profile, device: str | None = None, progress: bool = True,
                pretrained_model: str | None = None) -> dict:
     """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``."""
+    dataset.split("train"), dataset.split("test")    # both needed: refused now, not after the trainings
     make_folder(out)                 # a file in the way, or no permission: one sentence
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:

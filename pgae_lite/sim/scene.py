@@ -37,18 +37,8 @@ from pybullet_utils import bullet_client
 
 from pgae_lite.sim._quiet import silenced
 from pgae_lite.sim.robot import Robot
-from pgae_lite.world.words import COLOURS
+from pgae_lite.world.colours import CUBE_RGBA, TABLE_RGBA
 
-#: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.world.words`.
-CUBE_RGBA: dict[str, tuple[float, float, float, float]] = {
-    "red": (0.86, 0.08, 0.06, 1.0),
-    "green": (0.10, 0.72, 0.12, 1.0),
-    "blue": (0.08, 0.22, 0.92, 1.0),
-    "yellow": (0.96, 0.84, 0.06, 1.0),
-    "cyan": (0.05, 0.82, 0.86, 1.0),
-    "violet": (0.56, 0.16, 0.84, 1.0),
-}
-assert set(CUBE_RGBA) == set(COLOURS), "one RGBA per colour word of the language"
 
 CUBE_SIZE = 0.05                          # edge length (m)
 CUBE_MASS = 0.08                          # kg (a hollow wooden toy block)
@@ -57,7 +47,6 @@ TABLE_CENTRE_X = 0.19                     # x of the cube centres; the opposite 
 TABLE_X = (0.03, 2 * TABLE_CENTRE_X - 0.03)
 TABLE_HALF_WIDTH = 0.35
 TABLE_THICKNESS = 0.03
-TABLE_RGBA = (0.80, 0.74, 0.64, 1.0)      # light wood
 # Friction coefficients; pybullet multiplies those of the two bodies in contact.
 TABLE_FRICTION, CUBE_FRICTION = 1.0, 0.5  # cube on table: mu = 0.5
 # the hands' friction is a Scene argument (default 0.3: hand on cube 0.15; BRIEF §3: lower helped)

@@ -40,7 +40,7 @@ from pgae_lite.world.patterns import (
     pattern_number,
     pattern_parts,
 )
-from pgae_lite.world.words import DEFAULT_LEXICON, LanguageError, Lexicon, equivalent_descriptions
+from pgae_lite.world.words import COLOURS, DEFAULT_LEXICON, LanguageError, Lexicon, equivalent_descriptions
 
 #: The paper's patterns: 0-143 (:data:`pgae_lite.world.patterns.NUMBERING`).
 PAPER_PATTERNS = 144
@@ -69,12 +69,36 @@ class WorldPattern(Pattern):
         return np.array([[lex.word_index[w] for w in alt] for alt in alts])
 
 
+#: RGBA of each cube colour, keyed by the colour words of :mod:`pgae_lite.world.words`.
+CUBE_RGBA: dict[str, tuple[float, float, float, float]] = {
+    "red": (0.86, 0.08, 0.06, 1.0),
+    "green": (0.10, 0.72, 0.12, 1.0),
+    "blue": (0.08, 0.22, 0.92, 1.0),
+    "yellow": (0.96, 0.84, 0.06, 1.0),
+    "cyan": (0.05, 0.82, 0.86, 1.0),
+    "violet": (0.56, 0.16, 0.84, 1.0),
+}
+assert set(CUBE_RGBA) == set(COLOURS), "one RGBA per colour word of the language"
+#: RGBA of the table the cubes stand on (light wood).
+TABLE_RGBA = (0.80, 0.74, 0.64, 1.0)
+#: Least difference, in the most different of R, G and B, between two colours the camera must tell apart.
+MIN_COLOUR_DIFFERENCE = 0.2
+
+
+def nearest_colour(rgba: Sequence[float], others: dict[str, Sequence[float]]) -> tuple[str, float]:
+    """(the name of the colour of ``others`` nearest to ``rgba``, how far apart they are): the largest
+    difference over R, G and B, as the CAE sees the three channels apart."""
+    gaps = {name: max(abs(a - b) for a, b in zip(rgba[:3], other[:3])) for name, other in others.items()}
+    closest = min(gaps, key=gaps.get)
+    return closest, gaps[closest]
+
+
 @dataclass(frozen=True)
 class World:
     """Words, cube arrangements, test split, extra cube colours (default: the paper's).
 
     ``palette`` holds the RGBA of colours the simulator does not know
-    (:data:`pgae_lite.sim.scene.CUBE_RGBA` has the paper's six).
+    (:data:`CUBE_RGBA` has the paper's six).
     """
 
     lexicon: Lexicon = DEFAULT_LEXICON
@@ -184,6 +208,12 @@ def with_colour(name: str, synonym: str, rgba: Sequence[float],
     """
     lexicon = world.lexicon.with_colour(name, synonym)   # LanguageError: a word taken
     values = _check_rgba(name, rgba)
+    seen = {**{f"the {c} cube": v for c, v in {**CUBE_RGBA, **world.rgba}.items()}, "the table": TABLE_RGBA}
+    closest, gap = nearest_colour(values, seen)
+    if gap < MIN_COLOUR_DIFFERENCE:
+        raise ValueError(f"rgba of {name!r} is too close to {closest} for the camera: no colour channel differs "
+                         f"by more than {gap:.2f} (at least {MIN_COLOUR_DIFFERENCE} is needed); check it with "
+                         "pgae_lite.exercises.check_colour")
     partners = tuple(partners)
     unknown = [p for p in partners if p not in world.lexicon.colours]
     if not partners or unknown or len(set(partners)) < len(partners):
@@ -200,5 +230,6 @@ def with_colour(name: str, synonym: str, rgba: Sequence[float],
                  bigger.palette)
 
 
-__all__ = ["World", "WorldPattern", "DEFAULT_WORLD", "with_colour", "held_out",
+__all__ = ["World", "WorldPattern", "DEFAULT_WORLD", "with_colour", "held_out", "CUBE_RGBA", "TABLE_RGBA",
+           "MIN_COLOUR_DIFFERENCE", "nearest_colour",
            "EXTENSION_NUMBERING", "DEFAULT_PARTNERS", "PAPER_PATTERNS"]

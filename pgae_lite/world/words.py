@@ -282,6 +282,22 @@ def decode(indices: torch.Tensor | list[int], lexicon: Lexicon | None = None) ->
     return " ".join(words)
 
 
+def _chosen(scores: torch.Tensor, wanted: str) -> torch.Tensor:
+    """The word each row of scores (steps, n) chooses, read up to the first <BOS/EOS>; a row that is not
+    finite, or whose highest score is shared (no word chosen: an all-zero row), is a LanguageError."""
+    if scores.is_floating_point() and not torch.isfinite(scores).all():
+        row = int((~torch.isfinite(scores)).any(-1).nonzero()[0])
+        raise LanguageError(f"{wanted}; row {row} holds a value that is not finite (NaN or infinite)")
+    chosen = scores.argmax(-1)
+    ends = (chosen == 0).nonzero().flatten()
+    read = scores[: int(ends[0]) + 1 if len(ends) else len(scores)]          # the rows that are read
+    shared = ((read == read.max(-1, keepdim=True).values).sum(-1) > 1).nonzero().flatten()
+    if len(shared):
+        raise LanguageError(f"{wanted}; row {int(shared[0])} chooses no word (its highest score is shared by "
+                            "several words, e.g. a row of zeros)")
+    return chosen
+
+
 def _word_indices(indices, n: int) -> torch.Tensor:
     """:func:`decode`'s input checked: 1-D integer indices 0 to n-1 (n words), or a LanguageError."""
     wanted = (f"decode takes word indices (whole numbers 0-{n - 1}) or rows of "
@@ -296,7 +312,7 @@ def _word_indices(indices, n: int) -> torch.Tensor:
     except (TypeError, ValueError, RuntimeError, OverflowError):
         raise LanguageError(f"{wanted}; got {indices!r:.80}") from None
     if t.dim() == 2 and t.shape[1] == n and t.dtype != torch.bool:
-        return t.argmax(-1)       # (steps, 23) one-hot or probabilities
+        return _chosen(t, wanted)       # (steps, 23) one-hot or probabilities
     if t.dim() != 1 or t.dtype == torch.bool or t.is_complex():
         raise LanguageError(f"{wanted}; got {t.dim()}-D {t.dtype} of shape "
                             f"{tuple(t.shape)}")
