@@ -20,7 +20,8 @@ model) behaves bit for bit as before when given it or nothing.
   the new colour (action, speed) is held out in exactly one arrangement, on
   both cube sides, so every word and action type is seen in training and
   tested in a combination never trained (:func:`held_out`);
-- the RGBA of the new cube goes to the simulator (:mod:`pgae_lite.sim.scene`).
+- the RGBA of the new cube goes to the simulator (:mod:`pgae_lite.sim.scene`); one the camera
+  could not tell from a cube or the table is refused (:func:`nearest_colour`, the exercise's rule too).
 """
 from __future__ import annotations
 
