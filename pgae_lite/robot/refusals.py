@@ -12,7 +12,7 @@ understood of it and from the scene (the two cubes on the table):
   speeds it names;
 - the model's own readback (``repeat language``): the description it took the text to mean.
 
-Refused, with the reason in one sentence (:class:`CannotDo`):
+Refused, with the reason in one sentence (:class:`CannotDo`)::
 
     negation        a negator (not, never, n't, no, stop, avoid, ...) whose clause goes on
                     to name an action or a cube ("don't push the red cube"; a negated manner,

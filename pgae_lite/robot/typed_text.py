@@ -43,7 +43,7 @@ class TypedText:
     def features(self, signal: str) -> torch.Tensor:
         """(1, D): the encoder's features of the text after ``signal``'s phrase, computed once per signal.
 
-        The encoder reads the typed text as :attr:`read` shows it (its own lookup, applied once there)."""
+        The encoder reads the typed text as ``read`` shows it (its own lookup, applied once there)."""
         if signal not in self._features:
             self._features[signal] = self.encoder.encode_texts([input_text(signal, self.typed)])
         return self._features[signal]

@@ -68,7 +68,7 @@ def _quiet_client() -> bullet_client.BulletClient:
 class SceneLayout:
     """Where the cubes are: colours and centres (world frame, metres).
 
-    ``palette``: RGBA of colours beyond :data:`CUBE_RGBA` (a
+    ``palette``: RGBA of colours beyond :data:`~pgae_lite.world.colours.CUBE_RGBA` (a
     :class:`pgae_lite.world.colours.World`'s ``rgba``), e.g.
     ``SceneLayout("orange", "blue", palette=world.rgba)``.
     """
