@@ -12,7 +12,9 @@ for Python, with the system browser: no ``playwright install``):
 - no executed cell shows an error (traceback or ``Traceback`` on stderr);
 - saved widgets and matplotlib animations are drawn;
 - every link to a page of the book (navigation, sidebar, prev/next, text)
-  answers HTTP 200.
+  answers HTTP 200;
+- with no repository address, no launch, repository or issues button; every
+  chapter has a link to download it as a notebook.
 
 A full-page screenshot of each page goes to ``_build/screenshots/`` with a
 ``report.json`` of what was found and how long each page took. The module is
@@ -180,6 +182,9 @@ INSPECT = r"""async () => {
     links: [...document.querySelectorAll("a[href]")].map(a => a.href),
   };
 }"""
+# The book's repository address (empty: none), and links that need one: launch services, the repository's pages.
+REPOSITORY_URL = (yaml.safe_load((ROOT / "_config.yml").read_text(encoding="utf-8")).get("repository") or {}).get("url")
+LAUNCH = re.compile(r"colab\.research\.google\.com|mybinder\.org|github\.com/[^/]+/pgae_lite|/issues(/|$)")
 # Raw TeX that MathJax should have replaced: \( \) \[ \] $$, $x$ and \begin{...}.
 RAW_TEX = re.compile(r"\\\(|\\\)|\\\[|\\\]|\$\$|\$[^\s$][^$\n]{0,200}?[^\s$\\]\$|\\begin\{")
 
@@ -226,6 +231,12 @@ def test_page_renders_offline(docname, site, browser):
     # Links into the book (navigation, prev/next, cross-references) must lead to a page.
     internal = {link.split("#")[0] for link in seen["links"] if link.startswith(site)}
     found["broken_links"] = sorted(url for url in internal if http_status(url) != 200)
+    # No dead links: with no repository address (_config.yml's repository.url, book/_ext/repository_links.py)
+    # no launch, repository or issues button; every chapter downloadable as its notebook.
+    if not REPOSITORY_URL:
+        found["links_to_no_repository"] = sorted({link for link in seen["links"] if LAUNCH.search(link)})
+    if docname.startswith("notebooks/") and not any(link.split("#")[0].endswith(".ipynb") for link in internal):
+        found["no_notebook_download"] = [f"{docname}: no link to its .ipynb"]
 
     REPORT[docname] = {
         "seconds": round(time.perf_counter() - started, 2),
