@@ -15,6 +15,7 @@ and the book's reference page, ``book/api.md``, to one another):
 - ``config``     the recipes: the profiles smoke / book / paper and Table 1's trainings
 - ``runs``       the cached pipeline, side trainings, Table 1 over seeds, the results files (chapters 02-08, A1-A3)
 - ``robot``      the model drives the simulated robot: closed loop, instructions, playground (chapters 07, 08)
+- ``web``        the book in the reader's browser: the trained models as ONNX graphs (chapter 08)
 - ``viz``        plots and animations for the chapters, by topic
 - ``exercises``  check functions: a student's code against the package's, by chapter
 - ``util``       plumbing: errors, the cache folder, atomic writes, argument checks
