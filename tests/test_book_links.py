@@ -40,9 +40,11 @@ def test_unset_no_button_points_anywhere():
 
 
 def test_set_every_button_points_there():
-    given = {"repository_url": URL, "use_repository_button": True,
+    given = {"repository_url": URL, "use_repository_button": False,
              "launch_buttons": {"colab_url": "https://colab.research.google.com"}}
-    assert theme_options(given) == given
+    options = theme_options(given)
+    assert options["repository_url"] == URL and options["launch_buttons"] == given["launch_buttons"]
+    assert options["use_repository_button"] is True and options["use_issues_button"] is True
 
 
 def test_every_chapter_installs_from_the_address_the_build_fills_in():

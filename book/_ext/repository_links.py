@@ -12,10 +12,14 @@ from pathlib import Path
 BUTTONS = ("use_repository_button", "use_issues_button", "use_edit_page_button", "use_source_button")
 
 
+SHOWN = ("use_repository_button", "use_issues_button")          # turned on here when there is an address
+
+
 def theme_options(options: dict) -> dict:
-    """The theme options with every link to the repository left out when it has no address."""
+    """The theme options: the repository and issues buttons when the repository has an address (Jupyter
+    Book refuses them without one, so _config.yml leaves them off), every link to it left out when not."""
     if (options.get("repository_url") or "").strip():
-        return options
+        return {**options, **{button: True for button in SHOWN}}
     return {**{k: v for k, v in options.items() if k not in ("launch_buttons", "repository_url")},
             **{button: False for button in BUTTONS}}
 

@@ -12,16 +12,19 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 
 MATHJAX=3.2.2                  # MathJax 3, what Sphinx 7 targets
 HTML_MANAGER=1.0.15            # @jupyter-widgets/html-manager for ipywidgets 8
+ORT=1.30.0                     # onnxruntime-web: the live playground runs the models (book/_js/pgae.js)
 
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 # `npm pack` fetches just the published tarballs (no dependencies, no install scripts).
-npm pack --silent --pack-destination "$tmp" "mathjax@$MATHJAX" "@jupyter-widgets/html-manager@$HTML_MANAGER" >/dev/null
-mkdir "$tmp/mathjax" "$tmp/widgets"
+npm pack --silent --pack-destination "$tmp" "mathjax@$MATHJAX" "@jupyter-widgets/html-manager@$HTML_MANAGER" \
+    "onnxruntime-web@$ORT" >/dev/null
+mkdir "$tmp/mathjax" "$tmp/widgets" "$tmp/ort"
 tar xzf "$tmp"/mathjax-*.tgz -C "$tmp/mathjax" --strip-components=1
 tar xzf "$tmp"/jupyter-widgets-html-manager-*.tgz -C "$tmp/widgets" --strip-components=1
+tar xzf "$tmp"/onnxruntime-web-*.tgz -C "$tmp/ort" --strip-components=1
 
-rm -rf mathjax widgets
+rm -rf mathjax widgets ort
 # MathJax: the *full* TeX bundle has every TeX extension built in, so nothing is
 # loaded lazily ("autoload") at reading time; plus the CHTML fonts it asks for,
 # found relative to the script (output/chtml/fonts/woff-v2).
@@ -35,5 +38,12 @@ cp -r "$tmp/mathjax/es5/output/chtml/fonts/woff-v2" mathjax/output/chtml/fonts/
 mkdir widgets
 cp "$tmp/widgets/dist/embed.js" "$tmp/widgets/dist/embed.js.LICENSE.txt" "$tmp"/widgets/dist/*.woff2 widgets/
 
-find mathjax widgets -type f | LC_ALL=C sort | xargs sha256sum > SHA256SUMS
-echo "vendored mathjax@$MATHJAX, @jupyter-widgets/html-manager@$HTML_MANAGER: $(du -sh --exclude=update.sh . | cut -f1)"
+# onnxruntime-web: the WebAssembly build alone (no WebGL/WebGPU), its loader and the single .wasm it
+# loads (SIMD; threads only where the page is cross-origin isolated, else one thread). package.json
+# holds its licence (MIT).
+mkdir ort
+cp "$tmp/ort/dist/ort.wasm.min.js" "$tmp/ort/dist/ort-wasm-simd-threaded.mjs" \
+   "$tmp/ort/dist/ort-wasm-simd-threaded.wasm" "$tmp/ort/package.json" ort/
+
+find mathjax widgets ort -type f | LC_ALL=C sort | xargs sha256sum > SHA256SUMS
+echo "vendored mathjax@$MATHJAX, @jupyter-widgets/html-manager@$HTML_MANAGER, onnxruntime-web@$ORT: $(du -sh --exclude=update.sh . | cut -f1)"

@@ -1,0 +1,30 @@
+"""The live playground's files: the trained models and test episodes, written into the built book.
+
+At the end of an HTML build, ``pgae_lite.web.assets.export_web`` writes the playground's models
+(ONNX), their feature tables and the test episodes to ``_static/web/`` from the cache, for the
+profile the chapters ran with (``PGAE_LITE_PROFILE``, ``book`` when unset). The chapters have
+trained those models by then (executed, or by the notebook run before a build with execution
+off), so nothing is trained here unless the cache lacks a model. ``book/_js/pgae.js`` reads them.
+"""
+from pathlib import Path
+
+from sphinx.util import logging
+
+logger = logging.getLogger(__name__)
+
+
+def export(app, exception):
+    if exception is not None or app.builder.format != "html":
+        return
+    from pgae_lite.config import profile_name
+    from pgae_lite.web.assets import export_web
+
+    manifest = export_web(Path(app.outdir) / "_static" / "web", profile_name())
+    sizes = sum(m["bytes"] for m in manifest["models"].values())
+    logger.info(f"live playground: {len(manifest['models'])} models ({sizes / 1e6:.1f} MB of graphs) and "
+             f"{len(manifest['episodes'])} test episodes in _static/web ({manifest['profile']} profile)")
+
+
+def setup(app):
+    app.connect("build-finished", export)
+    return {"parallel_read_safe": True, "parallel_write_safe": True}

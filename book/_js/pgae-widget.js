@@ -1,0 +1,103 @@
+// The live playground's controls and drawings (chapter 08): every element with class
+// "pgae-live" becomes a small form that calls window.pgae.run (pgae.js) and shows, computed in
+// the page, the words the model writes, what it understood of a typed text, its joints against
+// the target, and the GMU gate. Nothing here computes the model: it only collects and draws.
+(function () {
+  "use strict";
+  const COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd"];   // one per joint
+  const SIGNALS = ["execute", "describe", "repeat action", "repeat language"];
+
+  function element(tag, attrs = {}, ...children) {
+    const e = document.createElement(tag);
+    Object.entries(attrs).forEach(([k, v]) => (k === "text" ? (e.textContent = v) : e.setAttribute(k, v)));
+    children.forEach(c => e.appendChild(c));
+    return e;
+  }
+
+  function select(label, options) {
+    const s = element("select", {"aria-label": label});
+    options.forEach(([value, text]) => s.appendChild(element("option", {value, text})));
+    return s;
+  }
+
+  // The target of a signal's joints (pgae_lite.robot.playground.TARGETS): the recording, or one pose held.
+  function target(recorded, signal) {
+    if (signal === "describe") return recorded.map(() => recorded[recorded.length - 1]);
+    if (signal === "repeat language") return recorded.map(() => recorded[0]);
+    return recorded;
+  }
+
+  function plotJoints(canvas, joints, wanted) {
+    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, pad = 30;
+    const all = joints.concat(wanted).flat(), lo = Math.min(...all), hi = Math.max(...all) + 1e-9;
+    const x = (t) => pad + (W - 2 * pad) * t / Math.max(1, joints.length - 1);
+    const y = (v) => H - pad - (H - 2 * pad) * (v - lo) / (hi - lo);
+    g.clearRect(0, 0, W, H);
+    g.strokeStyle = "#999"; g.strokeRect(pad, pad, W - 2 * pad, H - 2 * pad);
+    g.fillStyle = "#333"; g.font = "11px sans-serif";
+    g.fillText("joints: model (dashed) and target (solid), by step", pad, pad - 8);
+    for (let j = 0; j < 5; j++) {
+      [[wanted, []], [joints, [5, 4]]].forEach(([series, dash]) => {
+        g.setLineDash(dash); g.strokeStyle = COLOURS[j]; g.beginPath();
+        series.forEach((pose, t) => (t ? g.lineTo(x(t), y(pose[j])) : g.moveTo(x(t), y(pose[j]))));
+        g.stroke();
+      });
+    }
+    g.setLineDash([]);
+  }
+
+  function plotGate(canvas, gate) {
+    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, pad = 20, w = (W - 2 * pad) / gate.length;
+    g.clearRect(0, 0, W, H);
+    g.fillStyle = "#333"; g.font = "11px sans-serif";
+    const mean = gate.reduce((a, b) => a + b, 0) / gate.length;
+    g.fillText(`GMU gate z per dimension of h, mean ${mean.toFixed(2)} (0 language, 1 action)`, pad, 12);
+    gate.forEach((z, k) => {
+      g.fillStyle = `rgb(${Math.round(255 * z)}, 80, ${Math.round(255 * (1 - z))})`;
+      g.fillRect(pad + k * w, H - pad - (H - 2 * pad - 10) * z, Math.max(1, w - 1), (H - 2 * pad - 10) * z);
+    });
+  }
+
+  window.pgaeWidget = async function (root) {
+    root.textContent = "Loading the models (onnxruntime-web)...";
+    let manifest;
+    try {
+      manifest = await window.pgae.load();
+    } catch (e) {
+      root.textContent = `The live playground cannot start: ${e.message}`;
+      return;
+    }
+    const model = select("model", Object.keys(manifest.models).map(m => [m, m]));
+    const signal = select("signal", SIGNALS.map(s => [s, s]));
+    const episode = select("episode", manifest.episodes.map(e => [e.id, `${e.id}: ${e.description} ` +
+                                                                  `(${e.scene[0]} left, ${e.scene[1]} right)`]));
+    const text = element("input", {type: "text", size: "34", "aria-label": "text",
+                                   placeholder: "or type a description, e.g. push red slowly"});
+    const button = element("button", {type: "button", text: "Run"});
+    const said = element("pre", {class: "pgae-live-said"});
+    const joints = element("canvas", {width: "640", height: "260"});
+    const gate = element("canvas", {width: "640", height: "120"});
+    root.textContent = "";
+    [model, signal, episode, text, button].forEach(c => root.appendChild(c));
+    [said, joints, gate].forEach(c => root.appendChild(c));
+    button.addEventListener("click", async () => {
+      button.disabled = true;
+      said.classList.remove("pgae-live-error");
+      try {
+        const t0 = performance.now();
+        const r = await window.pgae.run({model: model.value, signal: signal.value, episode: episode.value,
+                                         text: text.value});
+        said.textContent = (r.understood !== null ? `I understood: ${r.understood || "<EOS>"}\n` : "") +
+          `words: ${r.words || "<EOS>"}\ncomputed in this page in ${(performance.now() - t0).toFixed(0)} ms`;
+        plotJoints(joints, r.joints, target(window.pgae.recorded(episode.value), signal.value));
+        plotGate(gate, r.gate);
+        root.dataset.result = JSON.stringify(r);
+      } catch (e) {
+        said.textContent = `Cannot run this: ${e.message}`;
+        said.classList.add("pgae-live-error");
+      } finally {
+        button.disabled = false;
+      }
+    });
+  };
+})();

@@ -1,0 +1,191 @@
+// The live playground: PGAE runs in the reader's page, with no server (not in the paper).
+//
+// The book build writes the trained models as ONNX graphs and the test episodes into
+// _static/web/ (pgae_lite/web/assets.py); onnxruntime-web (WebAssembly, vendored in
+// _static/ort/) runs them here. One documented function:
+//
+//   window.pgae.run({model, signal, episode, text}) -> Promise of {words, understood, joints, gate}
+//
+// model: a name the playground offers ("PGAE", "PGAE-BERT", "PGAE-BERT-phrasings"); signal:
+// "describe", "execute", "repeat action" or "repeat language"; episode: a test episode's id,
+// e.g. "sim/116-0"; text (optional): a description (action colour speed) that replaces the
+// episode's words. words: what the model writes ("" for <EOS> alone); understood: the text said
+// back under "repeat language" (null without text); joints: (steps, 5) in the data's units, step
+// 0 the start pose, as pgae_lite.robot.playground.play returns them; gate: the GMU's z.
+// A bad argument rejects with the sentence Python gives. Each signal's inputs are built from
+// the episode as pgae_lite.model.signals.make_batch builds them.
+(function () {
+  "use strict";
+  const BASE = new URL(".", document.currentScript.src);        // .../_static/
+  let manifest = null, episodes = null, ortReady = null;
+  const sessions = {}, tables = {};
+
+  const pyrepr = (s) => (s.includes("'") ? `"${s}"` : `'${s}'`);   // Python's repr of a string
+
+  function loadScript(src) {
+    return new Promise((done, fail) => {
+      const s = document.createElement("script");
+      s.src = src; s.onload = done; s.onerror = () => fail(new Error(`cannot load ${src}`));
+      document.head.appendChild(s);
+    });
+  }
+
+  async function fetchOk(url) {
+    const r = await fetch(url);
+    if (!r.ok) throw new Error(`cannot load ${url} (HTTP ${r.status}): the book was built without its live models`);
+    return r;
+  }
+
+  async function load() {
+    if (!manifest) {
+      manifest = await (await fetchOk(new URL("web/manifest.json", BASE))).json();
+      episodes = new Float32Array(await (await fetchOk(new URL(`web/${manifest.episodes_file}`, BASE))).arrayBuffer());
+    }
+    if (!ortReady) {
+      ortReady = loadScript(new URL("ort/ort.wasm.min.js", BASE).href).then(() => {
+        ort.env.wasm.wasmPaths = new URL("ort/", BASE).href;
+        ort.env.wasm.numThreads = 1;                              // a plain static server: no threads
+      });
+    }
+    await ortReady;
+    return manifest;
+  }
+
+  async function session(name) {
+    if (!sessions[name]) {
+      const m = manifest.models[name];
+      sessions[name] = ort.InferenceSession.create(new URL(`web/${m.file}`, BASE).href,
+                                                   {executionProviders: ["wasm"]});
+      if (m.table) {
+        tables[name] = fetchOk(new URL(`web/${m.table}`, BASE)).then(r => r.arrayBuffer())
+                                                               .then(b => new Float32Array(b));
+      }
+    }
+    return sessions[name];
+  }
+
+  // pgae_lite.world.words: normalise_signal, tokenize, parse_description (same messages).
+  function normaliseSignal(signal) {
+    const key = String(signal).replace(/[\s_:-]+/g, " ").trim().toLowerCase();
+    if (!manifest.signals.includes(key)) {
+      throw new Error(`unknown signal ${pyrepr(String(signal))}; the signals are: ${manifest.signals.join(", ")}`);
+    }
+    return key;
+  }
+
+  function tokenize(text) {
+    const vocab = manifest.vocabulary;
+    const words = text.toLowerCase().replace(/<bos\/eos>/g, " ").replace(/[.,;:!?]/g, " ").split(/\s+/)
+      .filter(Boolean);
+    const tokens = [], unknown = [];
+    for (let i = 0; i < words.length; i++) {
+      const pair = words.slice(i, i + 2).join("-");
+      if (i + 1 < words.length && vocab.includes(pair)) { tokens.push(pair); i++; }
+      else (vocab.includes(words[i]) ? tokens : unknown).push(words[i]);
+    }
+    if (unknown.length) {
+      const listed = [...new Set(unknown)];
+      const known = vocab.filter(w => w !== vocab[0]).sort().join(", ");
+      throw new Error(`unknown word${listed.length > 1 ? "s" : ""} ${listed.map(pyrepr).join(", ")} in ` +
+                      `${pyrepr(text)}; the vocabulary is: ${known}`);
+    }
+    return tokens;
+  }
+
+  function parseDescription(text) {
+    const tokens = tokenize(text);
+    if (tokens.length !== 3) {
+      throw new Error(`a description has 3 words (action colour speed), got ${tokens.length} in ${pyrepr(text)}`);
+    }
+    tokens.forEach((token, k) => {
+      const slot = manifest.slots[k], canon = manifest.canonical[token];
+      if (!slot.includes(canon)) {
+        const allowed = slot.flatMap(w => [w, manifest.synonyms[w]]).join(", ");
+        throw new Error(`${pyrepr(token)} cannot be the ${manifest.slot_names[k]} word in ${pyrepr(text)}; ` +
+                        `allowed: ${allowed}`);
+      }
+    });
+    return tokens;
+  }
+
+  // One episode's inputs under one signal, as make_batch builds them (no opposite view).
+  function inputs(ep, s, words) {
+    const n = ep.steps, at = ep.offset, step = (t) => episodes.subarray(at + 35 * t, at + 35 * (t + 1));
+    const readsWords = manifest.reads_words[s], seesAction = manifest.sees_action[s];
+    const tokens = [manifest.signal_token + s, ...(readsWords ? [...words, manifest.eos] : [manifest.eos])];
+    const shown = seesAction ? n : 1;
+    const action = episodes.slice(at, at + 35 * shown);
+    const held = s === manifest.describe ? n - 1 : s === manifest.repeat_language ? 0 : -1;
+    const dec = new Float32Array(30 * (n - 1));
+    for (let t = 0; t < n - 1; t++) dec.set(step(held >= 0 ? held : t).subarray(0, 30), 30 * t);
+    const start = step(held >= 0 ? held : 0).slice(30, 35);
+    return {tokens, action, shown, dec, start, n};
+  }
+
+  function decode(logits) {                                         // (4, V): argmax, up to <EOS>
+    const V = manifest.vocabulary.length, words = [];
+    for (let k = 0; k < 4; k++) {
+      const row = Array.from(logits.subarray(V * k, V * (k + 1)));
+      const w = row.indexOf(Math.max(...row));
+      if (w === 0) break;
+      words.push(manifest.vocabulary[w]);
+    }
+    return words.join(" ");
+  }
+
+  async function forward(name, x) {
+    const m = manifest.models[name], sess = await session(name);
+    let language;
+    if (m.reads === "tokens") {
+      language = new ort.Tensor("int64", BigInt64Array.from(x.tokens.map(BigInt)), [1, x.tokens.length]);
+    } else {                                                        // PGAE-BERT: the encoder's features
+      const key = [...x.tokens, ...Array(5 - x.tokens.length).fill(manifest.eos)].join(",");
+      const row = manifest.fixed_rows[key], table = await tables[name], D = m.features;
+      language = new ort.Tensor("float32", table.slice(D * row, D * (row + 1)), [1, D]);
+    }
+    const out = await sess.run({
+      language, action_input: new ort.Tensor("float32", x.action, [1, x.shown, 35]),
+      dec_vision: new ort.Tensor("float32", x.dec, [1, x.n - 1, 30]),
+      start: new ort.Tensor("float32", x.start, [1, 5])});
+    return out;
+  }
+
+  async function run({model, signal, episode, text} = {}) {
+    await load();
+    if (!(model in manifest.models)) {
+      throw new Error(`unknown model ${pyrepr(String(model))}; the models are: ${Object.keys(manifest.models).join(", ")}`);
+    }
+    const s = manifest.signals.indexOf(normaliseSignal(signal));
+    const ep = manifest.episodes.find(e => e.id === episode);
+    if (!ep) throw new Error(`no test episode ${pyrepr(String(episode))}; e.g. ${manifest.episodes[0].id}`);
+    text = (text || "").trim();
+    const words = (text ? parseDescription(text) : ep.description.split(" ")).map(w => manifest.vocabulary.indexOf(w));
+    if (text && !manifest.reads_words[s]) {
+      throw new Error(`${pyrepr(manifest.signals[s])} reads no words: a text only picks the episode here, ` +
+                      "so choose the episode instead");
+    }
+    const x = inputs(ep, s, words), out = await forward(model, x);
+    let understood = null;
+    if (text) {                                                     // the text said back, no action shown
+      understood = decode((await forward(model, inputs(ep, manifest.repeat_language, words))).logits.data);
+    }
+    const [lo, hi] = manifest.joint_units;
+    const units = (v) => (v + 1) * (hi - lo) / 2 + lo;                // [-1, 1] -> the data's units
+    const joints = [Array.from(x.start, units)];
+    const J = out.joints.data;
+    for (let t = 0; t < x.n - 1; t++) joints.push(Array.from(J.subarray(5 * t, 5 * (t + 1)), units));
+    return {words: decode(out.logits.data), understood, joints, gate: Array.from(out.gate.data)};
+  }
+
+  // The recorded joints of an episode (steps, 5), in the data's units: what execute should write.
+  function recorded(episode) {
+    const ep = manifest.episodes.find(e => e.id === episode), at = ep.offset + 35 * ep.steps, out = [];
+    for (let t = 0; t < ep.steps; t++) out.push(Array.from(episodes.subarray(at + 5 * t, at + 5 * (t + 1))));
+    return out;
+  }
+
+  window.pgae = {run, load, recorded, manifest: () => manifest};
+  document.addEventListener("DOMContentLoaded", () => {
+    document.querySelectorAll(".pgae-live").forEach(el => window.pgaeWidget && window.pgaeWidget(el));
+  });
+})();

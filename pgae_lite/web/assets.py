@@ -1,0 +1,99 @@
+"""What the live playground reads in the page, written at build time (not in the paper).
+
+Paper, Sec. 3 and 4: the models of Table 1's playground and the test episodes they run on.
+:func:`export_web` writes, from the cache (no retraining when the chapters trained them):
+
+    models/NAME.onnx      each model's :class:`~pgae_lite.web.export.EpisodeGraph`
+    models/NAME.table     PGAE-BERT only: its features of the 869 fixed inputs, float32 (869, D),
+                          row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
+    episodes.bin          every test episode, normalised as the model reads it, float32:
+                          action input (T, 35), then recorded joints in data units (T, 5)
+    manifest.json         the vocabulary, signals, models, the episodes' index, the normaliser's
+                          joint units, and the file sizes
+
+The page (``book/_js/pgae.js``) builds each signal's inputs from these as
+:func:`pgae_lite.model.signals.make_batch` does, runs the graph with onnxruntime-web and
+turns the joints back into data units.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from pgae_lite.bert.pretrained import fixed_token_rows
+from pgae_lite.config import get_profile
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
+from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.runs.trainings import PHRASINGS
+from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
+from pgae_lite.web.export import to_onnx
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY
+
+#: The models the playground offers, by the name the page shows, and their trainings.
+MODELS = {"PGAE": "PGAE", "PGAE-BERT": "PGAE-BERT", "PGAE-BERT-phrasings": PHRASINGS}
+
+
+def _episodes(test: PGAEDataset, normaliser: Normaliser) -> tuple[np.ndarray, list[dict]]:
+    """The test episodes as one float32 array and an index (offsets in floats)."""
+    tensors = normaliser.tensors(test)
+    vision, joints = tensors["vision"], tensors["joints"]                     # (N, T, 30), (N, T, 5)
+    chunks, index, at = [], [], 0
+    for i in range(len(test)):
+        n = int(test.lengths[i])
+        action = torch.cat([vision[i, :n], joints[i, :n]], 1).numpy().astype(np.float32)   # (n, 35)
+        recorded = test.joints[i, :n].astype(np.float32)                                  # (n, 5) data units
+        p = Pattern.from_number(int(test.pattern[i]))
+        words = [VOCABULARY[w] for w in test.descriptions[i, 0] if w]            # its first description
+        index.append({"id": str(test.ids[i]), "pattern": int(test.pattern[i]), "steps": n, "offset": at,
+                      "description": " ".join(words), "scene": [p.left, p.right],
+                      "meaning": [p.action, p.colour, p.speed]})
+        chunks += [action.ravel(), recorded.ravel()]
+        at += action.size + recorded.size
+    return np.concatenate(chunks), index
+
+
+def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False) -> dict:
+    """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest."""
+    out = make_folder(out)
+    make_folder(out / "models")
+    prof = get_profile(profile)
+    data = simulated_dataset(prof.name, "cpu", progress=progress)
+    models, normaliser = {}, None
+    for name, training in MODELS.items():
+        run = trained_pgae(training, prof.name, seed, device="cpu", progress=progress)
+        model = run.model.cpu().eval()
+        if normaliser is not None and normaliser != run.normaliser:
+            raise ValueError(f"{name} was trained with other data units than the first model: the page holds "
+                             "one copy of the episodes, normalised once")
+        normaliser = run.normaliser
+        entry = {"file": f"models/{name}.onnx", "bytes": len(to_onnx(model, out / "models" / f"{name}.onnx")),
+                 "reads": "features" if model.language_encoder.reads_free_text else "tokens"}
+        if entry["reads"] == "features":
+            with torch.no_grad():
+                table = model.language_encoder(fixed_token_rows()).numpy().astype(np.float32)   # (869, D)
+            with atomic_write(out / "models" / f"{name}.table") as f:
+                f.write(table.tobytes())
+            entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
+        models[name] = entry
+    values, episodes = _episodes(data.split("test"), normaliser)
+    with atomic_write(out / "episodes.bin") as f:
+        f.write(values.tobytes())
+    manifest = {
+        "profile": prof.name, "seed": seed, "vocabulary": list(VOCABULARY), "synonyms": SYNONYMS,
+        "canonical": dict(DEFAULT_LEXICON.canonical), "slots": [list(slot) for slot in SLOTS],
+        "slot_names": list(SLOT_NAMES), "signals": list(SIGNALS), "reads_words": [bool(x) for x in LANG_IN],
+        "sees_action": [bool(x) for x in ACTION_IN], "describe": SIGNALS.index("describe"),
+        "repeat_language": SIGNALS.index("repeat language"), "signal_token": SIGNAL_TOKEN, "eos": EOS,
+        "models": models, "episodes": episodes, "episodes_file": "episodes.bin", "joint_units": list(normaliser.joints),
+        "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(fixed_token_rows().tolist())},
+    }
+    atomic_write_text(out / "manifest.json", json.dumps(manifest))
+    return manifest
+
+
+__all__ = ["MODELS", "export_web"]
