@@ -228,20 +228,20 @@ def test_decode_refuses_rows_that_choose_no_word():
         decode(scores)
 
 
-@pytest.mark.parametrize("line, says", [("XYZZY train", "'XYZZY' 'train' is not an action of the world"),
+@pytest.mark.parametrize("line, says", [("XYZZY train", "'XYZZY train' is not an action of the world"),
                                         ("\U0001f642 test", "is not an action of the world"),
-                                        ("PUSH-L-SLOW maybe", "'maybe' is not an action")])
+                                        ("PUSH-L-SLOW maybe", "'PUSH-L-SLOW maybe' is not an action")])
 def test_the_authors_action_labels_are_checked(tmp_path, line, says):
     from pgae_lite.data.dataset import DataFormatError
     from pgae_lite.data.original import _read_patterns
 
     (tmp_path / "actions.txt").write_text(f"PUSH-L-SLOW train\n{line}\n", encoding="utf-8")
     (tmp_path / "arrangements.txt").write_text("red+blue\nred+blue\n")
-    with pytest.raises(DataFormatError, match=f"actions.txt, entry 2: .*{says}"):
+    with pytest.raises(DataFormatError, match=f"actions.txt, line 2: .*{says}"):
         _read_patterns(tmp_path)
     (tmp_path / "actions.txt").write_text("PUSH-L-SLOW train\nPULL-R-FAST test\n")
     (tmp_path / "arrangements.txt").write_text("red+blue\nred+orange\n")
-    with pytest.raises(DataFormatError, match="arrangements.txt, entry 2: 'red\\+orange' is not two colours"):
+    with pytest.raises(DataFormatError, match="arrangements.txt, line 2: 'red\\+orange' is not two colours"):
         _read_patterns(tmp_path)
 
 

@@ -144,15 +144,31 @@ class PGAEDataset:
         if checked and saved["digest"] != content:
             raise DataFormatError(f"{path}: its arrays do not match the digest saved "
                                   "with them")
-        n = len(arrays["lengths"])
-        widths = {"joints": JOINT_DIM, "vision": VISION_DIM,
-                  "vision_opposite": VISION_DIM}
-        if any(len(a) != n for a in arrays.values()) or any(
-                arrays[k].shape[1:] != (MAX_STEPS, w) for k, w in widths.items()):
-            raise DataFormatError(f"{path}: arrays of inconsistent shapes")
+        _check_contents(path, arrays)
         data = cls(**arrays, source=source)
         data.check_finite()
         return data
+
+
+def _check_contents(path, arrays: dict[str, np.ndarray]) -> None:
+    """:class:`DataFormatError` unless the arrays of a dataset file have the shapes, kinds and ranges
+    :class:`PGAEDataset` describes (an integer ``is_test`` would select samples by index, not by flag)."""
+    n = arrays["lengths"].shape[0] if arrays["lengths"].ndim else -1
+    steps = {"joints": (n, MAX_STEPS, JOINT_DIM), "vision": (n, MAX_STEPS, VISION_DIM),
+             "vision_opposite": (n, MAX_STEPS, VISION_DIM), "descriptions": (n, 8, 3)}
+    kinds = {"f": "numbers", "iu": "whole numbers", "b": "true or false", "U": "text"}
+    for name, kind in (("joints", "f"), ("vision", "f"), ("vision_opposite", "f"), ("lengths", "iu"),
+                       ("descriptions", "iu"), ("pattern", "iu"), ("is_test", "b"), ("ids", "U"),
+                       ("action", "U"), ("arrangement", "U")):
+        a, shape = arrays[name], steps.get(name, (n,))
+        if a.shape != shape or a.dtype.kind not in kind:
+            raise DataFormatError(f"{path}: {name} must hold {kinds[kind]} of shape {shape}; found {a.dtype} "
+                                  f"of shape {a.shape} (a file written by PGAEDataset.save holds them)")
+    for name, low, high in (("lengths", 1, MAX_STEPS), ("descriptions", 0, None), ("pattern", 0, None)):
+        a = arrays[name]
+        if a.size and (a.min() < low or (high is not None and a.max() > high)):
+            allowed = f"from {low} to {high}" if high is not None else f"{low} or more"
+            raise DataFormatError(f"{path}: {name} must be {allowed}; found {a.min()} to {a.max()}")
 
 
 #: How visual features can be scaled to [-1, 1] (see :meth:`Normaliser.fit`).

@@ -23,6 +23,8 @@ from pgae_lite.world.patterns import MAX_STEPS, Pattern
 from pgae_lite.world.words import COLOURS, VOCABULARY
 
 _SUBTREES = ("behavior", "vision", "vision_opp", "language")
+#: The world's 144 patterns: line k of actions.txt and arrangements.txt is pattern k - 1.
+PATTERNS = [Pattern.from_number(i) for i in range(144)]
 
 
 def load_original(path: str | Path) -> PGAEDataset:
@@ -119,27 +121,39 @@ def _descriptions(path: Path, lang: np.ndarray, pattern: int) -> np.ndarray:
     return tokens[:, 1:4]
 
 
+def _entries(path: Path) -> list[tuple[int, list[str]]]:
+    """(line number, words) of each non-blank line of one of the authors' pattern files."""
+    if not path.is_file():
+        raise DataFormatError(f"missing {path} (one line per pattern, from the authors' repository)")
+    return [(n, line.split()) for n, line in enumerate(text_of(path).splitlines(), 1) if line.strip()]
+
+
 def _read_patterns(root: Path) -> dict[int, tuple[str, str, str]]:
+    """Pattern number -> (action label, arrangement, split) from ``actions.txt`` and ``arrangements.txt``:
+    line k of each must be the world's pattern k - 1 (:class:`~pgae_lite.world.patterns.Pattern`)."""
     actions_file, arrangements_file = root / "actions.txt", root / "arrangements.txt"
-    for f in (actions_file, arrangements_file):
-        if not f.is_file():
-            raise DataFormatError(f"missing {f} (one line per pattern, from the authors' repository)")
-    actions = [line.split() for line in text_of(actions_file).splitlines() if line.strip()]
-    arrangements = [line.strip() for line in text_of(arrangements_file).splitlines() if line.strip()]
-    if len(actions) != len(arrangements) or any(len(a) != 2 for a in actions):
-        raise DataFormatError(f"{actions_file} must have 'ACTION-CUBE-SPEED train|test' per line, "
-                              f"as many lines as {arrangements_file}")
+    actions, arrangements = _entries(actions_file), _entries(arrangements_file)
     labels = [f"{a}-{side}-{speed}" for a in ("PUSH", "PULL", "SLIDE") for side in "LR" for speed in ("SLOW", "FAST")]
-    for line, (label, split) in enumerate(actions, 1):
-        if label not in labels or split not in ("train", "test"):
-            raise DataFormatError(f"{actions_file}, entry {line}: {label!r:.40} {split!r:.20} is not an "
-                                  f"action of the world and a split; the actions are {', '.join(labels)}, the "
-                                  "splits train and test")
-    for line, arrangement in enumerate(arrangements, 1):
-        if not all(c in COLOURS for c in arrangement.split("+")) or arrangement.count("+") != 1:
-            raise DataFormatError(f"{arrangements_file}, entry {line}: {arrangement!r:.40} is not two "
+    for line, words in actions:
+        label, split = (words + ["", ""])[:2]
+        if len(words) != 2 or label not in labels or split not in ("train", "test"):
+            raise DataFormatError(f"{actions_file}, line {line}: {' '.join(words)!r:.60} is not an action of the "
+                                  f"world and a split; each line must be 'ACTION-CUBE-SPEED train|test' with the "
+                                  f"actions {', '.join(labels)}")
+    for line, words in arrangements:
+        if len(words) != 1 or words[0].count("+") != 1 or not all(c in COLOURS for c in words[0].split("+")):
+            raise DataFormatError(f"{arrangements_file}, line {line}: {' '.join(words)!r:.40} is not two "
                                   f"colours of the world joined by '+'; the colours are {', '.join(COLOURS)}")
-    return {i: (a[0], arr, a[1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
+    if len(actions) != len(arrangements) or len(actions) > len(PATTERNS):
+        raise DataFormatError(f"{actions_file} and {arrangements_file} must have one line per pattern, at most "
+                              f"{len(PATTERNS)}; found {len(actions)} and {len(arrangements)}")
+    for number, ((line, (label, split)), (_, (arrangement,))) in enumerate(zip(actions, arrangements)):
+        p = PATTERNS[number]
+        world = (p.code, "test" if p.is_test else "train", f"{p.left}+{p.right}")
+        if (label, split, arrangement) != world:
+            raise DataFormatError(f"{actions_file}, line {line}: pattern {number} is {' '.join(world)!r} in the "
+                                  f"world (pgae_lite.world.patterns); the files say {label} {split} {arrangement}")
+    return {i: (a[1][0], arr[1][0], a[1][1]) for i, (a, arr) in enumerate(zip(actions, arrangements))}
 
 
 __all__ = ["load_original"]

@@ -16,7 +16,7 @@ import numpy as np
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.evaluate import nrmse, predict
 from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
-from pgae_lite.world.colours import CUBE_RGBA, MIN_COLOUR_DIFFERENCE, TABLE_RGBA, World, nearest_colour
+from pgae_lite.world.colours import MIN_COLOUR_DIFFERENCE, World, nearest_seen
 from pgae_lite.exercises.result import RAISED, CheckResult, _call, _numbers
 
 #: Describe accuracy (%) on the held-out episodes that move the new colour's cube.
@@ -64,10 +64,10 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = MIN_C
     apart from the other cubes and the table (some channel differs by ``min_difference`` or more).
 
     ``world``: compare with its colours too (:func:`pgae_lite.world.colours.with_colour`)."""
-    colours = world.lexicon.colours if world is not None else COLOURS
-    rgbas = {**CUBE_RGBA, **(world.rgba if world is not None else {})}
-
     result = CheckResult(f"cube colour {name!r}")
+    if world is not None and not isinstance(world, World):
+        return result.fail(f"world must be a World (what with_colour returned) or None; got {world!r:.60}")
+    colours = world.lexicon.colours if world is not None else COLOURS
     if not isinstance(name, str) or not name or name != name.lower() or " " in name:
         result.fail(f"{name!r} should be one lowercase word (a hyphen joins two, as in greenish-blue)")
     elif name in colours:
@@ -86,9 +86,7 @@ def check_colour(name: str, rgba: Sequence[float], min_difference: float = MIN_C
         result.fail(f"alpha is {values[3]}; the cubes are opaque (alpha 1.0)")
     if not result:
         return result
-    others = {**{f"the {c} cube": v for c, v in rgbas.items() if c != name},
-              "the table": TABLE_RGBA}
-    closest, gap = nearest_colour(values, others)          # the rule with_colour applies too
+    closest, gap = nearest_seen(values, world, without=name)          # the rule with_colour applies too
     if gap < min_difference:
         result.fail(f"too close to {closest}: no colour channel differs by more than {gap:.2f}",
                     f"the CAE sees R, G and B separately: make one channel differ by {min_difference} or more")

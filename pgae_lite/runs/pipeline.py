@@ -161,7 +161,7 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
 
     training = as_training(training)
     base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
-    dataset = simulated_dataset(base, device, progress)
+    dataset = _with_both_splits(simulated_dataset(base, device, progress))
     prof = training_profile(base, training)
     folder = _model_folder(prof, training.name)
     announced = False
@@ -178,6 +178,13 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
                 print(f"{training.name}: another process is training this model; waiting for it ...", flush=True)
             announced = True
             time.sleep(BUSY_POLL_SECONDS)
+
+
+def _with_both_splits(dataset: PGAEDataset) -> PGAEDataset:
+    """``dataset``, or a DataFormatError before any training if it lacks training or test samples: Table 1's
+    models are trained on the one and measured on the other."""
+    dataset.split("train"), dataset.split("test")
+    return dataset
 
 
 def _train_alone(training: Training, profile: Profile, seed: int) -> float:
@@ -209,7 +216,7 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
     todo = [t for t in {t.name: t for t in trainings}.values() if not _finished(t, prof, seed)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
-        simulated_dataset(prof, device, progress)         # recorded and encoded once, before the workers read it
+        _with_both_splits(simulated_dataset(prof, device, progress))   # made once, before the workers read it
         if progress:
             names = ", ".join(t.name for t in todo)
             print(f"training {names} side by side, {workers} at a time, one core each ...", flush=True)

@@ -22,9 +22,9 @@ does not have. Superseded files lie in ``results/history/`` and are named ``hist
 from __future__ import annotations
 
 import json
-import math
 import os
 import re
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -46,25 +46,40 @@ class ResultFileError(PGAELiteError, ValueError):
     """A result file that is damaged, or holds what must not be rendered (one sentence naming the file)."""
 
 
-# Text rendered into Markdown or HTML: no table cell separator, no tag, no line break, no generated-block marker.
-_MARKUP = re.compile(r"[|<>\n\r`]|<!--|-->")
+# Text rendered into Markdown or HTML: no table cell separator, no tag, no backquote, no generated-block marker,
+# no line break and no other control character (U+0085, U+2028 and U+2029 break lines too).
+_MARKUP = re.compile(r"[|<>`\x00-\x1f\x7f-\x9f\u2028\u2029]")
+# Outside a code span, also no emphasis, link, escape or entity.
+_INLINE = re.compile(r"[|<>`\x00-\x1f\x7f-\x9f\u2028\u2029*_\[\]\\&]")
 
 
-def text_of(value, where: str) -> str:
-    """``value`` when it is a string that renders as itself in Markdown; else a :class:`ResultFileError`."""
+def text_of(value, where: str, code: bool = False) -> str:
+    """``value`` when it is a string that renders as itself in Markdown (``code``: in a code span);
+    else a :class:`ResultFileError`."""
     if not isinstance(value, str):
         raise ResultFileError(f"{where} must be a string; got {type(value).__name__} {value!r:.60}")
-    if _MARKUP.search(value):
-        raise ResultFileError(f"{where} holds markup ({_MARKUP.search(value).group(0)!r}: a table separator, tag, "
-                              f"backquote or line break), which would not render as itself; got {value!r:.80}")
+    found = (_MARKUP if code else _INLINE).search(value)
+    if found:
+        raise ResultFileError(f"{where} holds markup ({found.group(0)!r}: "
+                              "a table separator, tag, backquote, line break, control character, emphasis, link "
+                              f"or entity), which would not render as itself; got {value!r:.80}")
     return value
 
 
 def number_of(value, where: str) -> float:
     """``value`` when it is a finite number (not a bool); else a :class:`ResultFileError`."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
         raise ResultFileError(f"{where} must be a finite number; got {value!r:.60}")
     return float(value)
+
+
+def count_of(value, where: str) -> str:
+    """``value`` as text when it is a whole number >= 1 (cores, threads) or a plain string; else a ResultFileError."""
+    if isinstance(value, str):
+        return text_of(value, where)
+    if not isinstance(value, int) or isinstance(value, bool) or value < 1:
+        raise ResultFileError(f"{where} must be a whole number >= 1 or a plain text; got {value!r:.60}")
+    return str(value)
 
 
 def seeds_of(value, where: str) -> list[int]:
@@ -150,11 +165,8 @@ def measured(name: str) -> str:
     m = r.get("machine", {})
     if not isinstance(m, dict):
         raise ResultFileError(f"{name}.json: machine must be an object; got {m!r:.60}")
-    said = {}
-    for key in ("cpu", "cores", "torch", "threads"):
-        v = m.get(key, "?")
-        said[key] = str(v) if isinstance(v, int) and not isinstance(v, bool) else \
-            text_of(v, f"{name}.json: machine.{key}")
+    said = {key: count_of(m.get(key, "?"), f"{name}.json: machine.{key}")
+            for key in ("cpu", "cores", "torch", "threads")}
     threads = m.get("threads", "?")
     where = f"{said['cpu']}, {said['cores']} cores, {said['threads']} thread{'' if threads == 1 else 's'}"
     if m.get("gpu"):
@@ -162,9 +174,44 @@ def measured(name: str) -> str:
     seeds = r.get("seeds")
     seeds = seeds if seeds is None else seeds_of(seeds, f"{name}.json: seeds")
     profile = r.get("profile") if r.get("profile") is None else text_of(r["profile"], f"{name}.json: profile")
-    return (f"measured {text_of(r.get('date'), f'{name}.json: date')[:10]} at commit "
+    date = text_of(r.get("date"), f"{name}.json: date")
+    if not re.match(r"\d{4}-\d{2}-\d{2}", date):
+        raise ResultFileError(f"{name}.json: date must be an ISO date and time (2026-11-27T13:29:04+00:00); "
+                              f"got {date!r:.60}")
+    return (f"measured {date[:10]} at commit "
             f"{text_of(r.get('commit'), f'{name}.json: commit')} ({where}, torch {said['torch']}, "
-            f"profile {profile}, seeds {seeds}) by `{text_of(r.get('command'), f'{name}.json: command')}`")
+            f"profile {profile}, seeds {seeds}) by `{text_of(r.get('command'), f'{name}.json: command', code=True)}`")
+
+
+def table1_rows(name: str) -> dict[str, dict]:
+    """The rows of a ``benchmarks/table1.py`` result, each a row of Table 1 (:data:`~pgae_lite.config.ROWS`)."""
+    data = load(name)["data"].get("rows")
+    if not isinstance(data, dict) or not data:
+        raise ResultFileError(f"{name}.json: data.rows must be an object with one entry per row of Table 1 "
+                              f"({', '.join(ROWS)}); got {data!r:.60}")
+    for row, r in data.items():
+        if row not in ROWS:
+            raise ResultFileError(f"{name}.json: row {row!r:.60} is not a row of Table 1; the rows "
+                                  f"are: {', '.join(ROWS)}")
+        if not isinstance(r, dict):
+            raise ResultFileError(f"{name}.json: rows[{row!r}] must be an object; got {r!r:.60}")
+    return data
+
+
+def _cell(name: str, row: str, r: dict, what: str, signal: str, key: str) -> float:
+    """One figure of a Table 1 row: our median, the paper's, or the min or max over the seeds."""
+    where, figure = f"{name}.json: rows[{row!r}]", f"{signal} {key} {what}"
+    try:
+        if what == "paper":
+            return number_of(r["paper"][signal][0 if key == "accuracy" else 1], f"{where} {figure}")
+        if what == "median":
+            return number_of(r["stats"][signal][key]["median"], f"{where} {figure}")
+        per_seed = [number_of(s[signal][key], f"{where} {signal} {key} of a seed") for s in r["seeds"].values()]
+    except (KeyError, IndexError, TypeError, AttributeError):
+        raise ResultFileError(f"{where} lacks the {figure}") from None
+    if not per_seed:
+        raise ResultFileError(f"{where} holds no seeds, so no {figure}")
+    return min(per_seed) if what == "min" else max(per_seed)
 
 
 def table1_frame(name: str, rows: list[str] | None = None) -> pd.DataFrame:
@@ -173,22 +220,16 @@ def table1_frame(name: str, rows: list[str] | None = None) -> pd.DataFrame:
     Columns are (signal, "accuracy %" or "nRMSE %"); each row of the paper is followed by
     ours: "median", "min", "max" (over seeds) and "paper".
     """
-    data = value(name, "rows")
+    data = table1_rows(name)
+    unknown = [row for row in rows or [] if row not in data]
+    if unknown:
+        raise KeyError(f"{name}.json has no row {unknown[0]!r}; it has: {', '.join(data)}")
     out = {}
     for row in rows or list(data):
-        seeds = data[row]["seeds"]
         for what in ("median", "min", "max", "paper"):
-            cells = {}
-            for i, signal in enumerate(TEST_SIGNALS):
-                for key, label in (("accuracy", "accuracy %"), ("nrmse", "nRMSE %")):
-                    if what == "paper":
-                        cells[(signal, label)] = data[row]["paper"][signal][0 if key == "accuracy" else 1]
-                    elif what == "median":
-                        cells[(signal, label)] = data[row]["stats"][signal][key]["median"]
-                    else:
-                        per_seed = [s[signal][key] for s in seeds.values()]
-                        cells[(signal, label)] = min(per_seed) if what == "min" else max(per_seed)
-            out[(row, what)] = cells
+            out[(row, what)] = {(signal, label): _cell(name, row, data[row], what, signal, key)
+                                for signal in TEST_SIGNALS
+                                for key, label in (("accuracy", "accuracy %"), ("nrmse", "nRMSE %"))}
     frame = pd.DataFrame(out).T
     frame.columns = pd.MultiIndex.from_tuples(frame.columns)
     return frame
@@ -196,33 +237,33 @@ def table1_frame(name: str, rows: list[str] | None = None) -> pd.DataFrame:
 
 def table1_met(name: str) -> dict[str, bool]:
     """Per row of a ``table1.py`` result: is every median cell at or better than the paper's?"""
-    return {row: all(all(v.values()) for v in r["verdict"].values()) for row, r in value(name, "rows").items()}
+    met = {}
+    for row, r in table1_rows(name).items():
+        verdict = r.get("verdict")
+        cells = [x for v in verdict.values() for x in v.values()] if isinstance(verdict, dict) and all(
+            isinstance(v, dict) for v in verdict.values()) else []
+        if not cells or not all(isinstance(x, bool) for x in cells):
+            raise ResultFileError(f"{name}.json: rows[{row!r}] verdict must map each signal to true or false "
+                                  f"per measure; got {verdict!r:.60}")
+        met[row] = all(cells)
+    return met
 
 
 def headline_table() -> str:
     """The README's headline table (Markdown): Table 1's medians on the authors' data next to the paper's."""
-    data = value("table1-original", "rows")
+    name = "table1-original"
     head = ("| row | describe % | repeat language % | execute nRMSE % | repeat action nRMSE % |\n"
             "|---|---|---|---|---|")
     lines = [head]
-    for row, r in data.items():
-        if row not in ROWS:
-            raise ResultFileError(f"table1-original.json: row {row!r:.60} is not a row of Table 1; the rows "
-                                  f"are: {', '.join(ROWS)}")
-        cells = []
-        for signal, key, digits in (("describe", "accuracy", 2), ("repeat language", "accuracy", 2),
-                                    ("execute", "nrmse", 3), ("repeat action", "nrmse", 3)):
-            where = f"table1-original.json: rows[{row!r}]"
-            try:
-                ours, paper = r["stats"][signal][key]["median"], r["paper"][signal][0 if key == "accuracy" else 1]
-            except (KeyError, IndexError, TypeError):
-                raise ResultFileError(f"{where} lacks the {signal} {key} median or the paper's figure") from None
-            cells.append(f"{number_of(ours, f'{where} {signal} {key} median'):.{digits}f} "
-                         f"({number_of(paper, f'{where} paper {signal}'):.2f})")
+    for row, r in table1_rows(name).items():
+        cells = [f"{_cell(name, row, r, 'median', signal, key):.{digits}f} "
+                 f"({_cell(name, row, r, 'paper', signal, key):.2f})"
+                 for signal, key, digits in (("describe", "accuracy", 2), ("repeat language", "accuracy", 2),
+                                             ("execute", "nrmse", 3), ("repeat action", "nrmse", 3))]
         lines.append(f"| {row} | " + " | ".join(cells) + " |")
-    seeds = seeds_of(load("table1-original").get("seeds"), "table1-original.json: seeds")
+    seeds = seeds_of(load(name).get("seeds"), f"{name}.json: seeds")
     lines.append(f"\nMedian over seeds {', '.join(map(str, seeds))} (the paper's figure in brackets); "
-                 f"{measured('table1-original')}.")
+                 f"{measured(name)}.")
     return "\n".join(lines)
 
 
@@ -278,8 +319,11 @@ README_START, README_END = "<!-- headline:start", "<!-- headline:end -->"
 
 def readme_with_headline(readme: str) -> str:
     """``readme`` (the README's text) with its generated block replaced by :func:`headline_table`."""
-    if README_START not in readme or README_END not in readme:
-        raise ValueError(f"the README has no generated block ({README_START} ... {README_END})")
+    starts, ends = readme.count(README_START), readme.count(README_END)
+    if starts != 1 or ends != 1 or readme.index(README_END) < readme.index(README_START) or \
+            "\n" not in readme.split(README_START, 1)[1].split(README_END, 1)[0]:
+        raise ValueError(f"the README must hold one generated block, {README_START} ... -->, a line break, then "
+                         f"{README_END}; found {starts} start and {ends} end markers")
     head, rest = readme.split(README_START, 1)
     first_line, _ = rest.split("\n", 1)
     _, tail = rest.split(README_END, 1)
@@ -295,8 +339,12 @@ if __name__ == "__main__":
     parser.add_argument("--root", default=None, help=f"the repository (default: ${REPOSITORY_ENV}, else the "
                                                      "folder at or above here with results/ and _toc.yml)")
     args = parser.parse_args()
-    root = repository(args.root)
-    os.environ[REPOSITORY_ENV] = str(root)          # every file below is read from this repository
-    readme = root / "README.md"
-    atomic_write_text(readme, readme_with_headline(readme.read_text(encoding="utf-8")))   # never left half-written
+    try:
+        root = repository(args.root)
+        os.environ[REPOSITORY_ENV] = str(root)          # every file below is read from this repository
+        readme = root / "README.md"
+        text = readme_with_headline(readme.read_text(encoding="utf-8"))
+    except (PGAELiteError, ValueError, OSError) as e:   # a damaged file or README: one line, no traceback
+        parser.exit(2, f"error: {e}\n")
+    atomic_write_text(readme, text)                     # never left half-written
     print(f"{readme}: headline table rewritten from {results_dir() / 'table1-original.json'}")

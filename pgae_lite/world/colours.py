@@ -21,7 +21,7 @@ model) behaves bit for bit as before when given it or nothing.
   both cube sides, so every word and action type is seen in training and
   tested in a combination never trained (:func:`held_out`);
 - the RGBA of the new cube goes to the simulator (:mod:`pgae_lite.sim.scene`); one the camera
-  could not tell from a cube or the table is refused (:func:`nearest_colour`, the exercise's rule too).
+  could not tell from a cube or the table is refused (:func:`nearest_seen`, the exercise's rule too).
 """
 from __future__ import annotations
 
@@ -178,6 +178,15 @@ class World:
 DEFAULT_WORLD = World()
 
 
+def nearest_seen(rgba: Sequence[float], world: World | None = None, without: str | None = None) -> tuple[str, float]:
+    """(what the camera sees nearest to ``rgba``, how far apart) among the cubes of ``world`` (the paper's six
+    and any added colour, except ``without``) and the table: the rule :func:`with_colour` and the exercise's
+    check_colour share. Below :data:`MIN_COLOUR_DIFFERENCE` apart the camera cannot tell the two apart."""
+    cubes = {**CUBE_RGBA, **(world or DEFAULT_WORLD).rgba}
+    seen = {**{f"the {c} cube": v for c, v in cubes.items() if c != without}, "the table": TABLE_RGBA}
+    return nearest_colour(rgba, seen)
+
+
 def held_out(j: int, action: int, speed: int, arrangements: int) -> bool:
     """Is ``action`` (0-5) at ``speed`` in the ``j``-th new arrangement a test pattern?
 
@@ -191,12 +200,17 @@ def held_out(j: int, action: int, speed: int, arrangements: int) -> bool:
 
 
 def _check_rgba(name: str, rgba: Sequence[float]) -> RGBA:
-    values = tuple(float(v) for v in rgba)
-    if len(values) != 4 or not all(0.0 <= v <= 1.0 for v in values) or values[3] != 1.0:
+    """``rgba`` as 4 floats when it is 4 numbers in [0, 1] with alpha 1.0; else a ValueError."""
+    def in_range(v) -> bool:     # a number (not True or False, not text) from 0 to 1; NaN is not
+        return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool) and 0 <= v <= 1
+
+    ok = (isinstance(rgba, (Sequence, np.ndarray)) and not isinstance(rgba, (str, bytes)) and len(rgba) == 4
+          and all(in_range(v) for v in rgba) and rgba[3] == 1)
+    if not ok:
         raise ValueError(f"rgba of {name!r} must be 4 numbers in [0, 1] with alpha 1.0 "
-                         f"(an opaque cube), got {tuple(rgba)}; check it with "
+                         f"(an opaque cube), got {rgba!r:.80}; check it with "
                          "pgae_lite.exercises.check_colour")
-    return values  # type: ignore[return-value]
+    return tuple(float(v) for v in rgba)  # type: ignore[return-value]
 
 
 def with_colour(name: str, synonym: str, rgba: Sequence[float],
@@ -207,14 +221,17 @@ def with_colour(name: str, synonym: str, rgba: Sequence[float],
     ``partners``: colours of ``world`` that the new cube shares the table with; each
     gives the arrangements (name, partner) and (partner, name), 24 new patterns.
     """
+    if not isinstance(world, World):
+        raise TypeError(f"world must be a World (DEFAULT_WORLD, or what with_colour returned); got {world!r:.60}")
     lexicon = world.lexicon.with_colour(name, synonym)   # LanguageError: a word taken
     values = _check_rgba(name, rgba)
-    seen = {**{f"the {c} cube": v for c, v in {**CUBE_RGBA, **world.rgba}.items()}, "the table": TABLE_RGBA}
-    closest, gap = nearest_colour(values, seen)
+    closest, gap = nearest_seen(values, world)
     if gap < MIN_COLOUR_DIFFERENCE:
         raise ValueError(f"rgba of {name!r} is too close to {closest} for the camera: no colour channel differs "
                          f"by more than {gap:.2f} (at least {MIN_COLOUR_DIFFERENCE} is needed); check it with "
                          "pgae_lite.exercises.check_colour")
+    if not isinstance(partners, (list, tuple)):
+        raise LanguageError(f"partners must be a list of colours of the world; got {partners!r:.60}")
     partners = tuple(partners)
     unknown = [p for p in partners if p not in world.lexicon.colours]
     if not partners or unknown or len(set(partners)) < len(partners):
@@ -232,5 +249,5 @@ def with_colour(name: str, synonym: str, rgba: Sequence[float],
 
 
 __all__ = ["World", "WorldPattern", "DEFAULT_WORLD", "with_colour", "held_out", "CUBE_RGBA", "TABLE_RGBA",
-           "MIN_COLOUR_DIFFERENCE", "nearest_colour",
+           "MIN_COLOUR_DIFFERENCE", "nearest_colour", "nearest_seen",
            "EXTENSION_NUMBERING", "DEFAULT_PARTNERS", "PAPER_PATTERNS"]

@@ -311,7 +311,7 @@ def _word_indices(indices, n: int) -> torch.Tensor:
         t = torch.as_tensor(indices)
     except (TypeError, ValueError, RuntimeError, OverflowError):
         raise LanguageError(f"{wanted}; got {indices!r:.80}") from None
-    if t.dim() == 2 and t.shape[1] == n and t.dtype != torch.bool:
+    if t.dim() == 2 and t.shape[1] == n and t.dtype != torch.bool and not t.is_complex():
         return _chosen(t, wanted)       # (steps, 23) one-hot or probabilities
     if t.dim() != 1 or t.dtype == torch.bool or t.is_complex():
         raise LanguageError(f"{wanted}; got {t.dim()}-D {t.dtype} of shape "
