@@ -1,7 +1,7 @@
 """What the live playground reads in the page, written at build time (not in the paper).
 
-Paper, Sec. 3 and 4: the models of Table 1's playground and the test episodes they run on.
-:func:`export_web` writes, from the cache (no retraining when the chapters trained them):
+Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes they run on.
+:func:`export_web` writes, from the cache (no retraining when the chapters trained them)::
 
     models/NAME.onnx      each model's :class:`~pgae_lite.web.export.EpisodeGraph`
     models/NAME.table     PGAE-BERT only: its features of the 869 fixed inputs, float32 (869, D),
