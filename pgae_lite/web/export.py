@@ -74,7 +74,7 @@ def episode_inputs(batch: SignalBatch, i: int, language: torch.Tensor | None = N
 
 def to_onnx(model: PGAE, path: str | Path | None = None) -> bytes:
     """The model's :class:`EpisodeGraph` as ONNX bytes (written atomically to ``path`` if given)."""
-    graph = EpisodeGraph(model).cpu()
+    graph = EpisodeGraph(model).cpu().eval()      # eval: the exporter restores the mode it found (see below)
     language = (torch.tensor([[24, 14, 16, 19, 0]]) if graph.reads_tokens          # execute push red slowly
                 else torch.zeros(1, model.language_encoder.output_dim))
     example = (language, torch.zeros(1, 4, 35), torch.zeros(1, 7, 30), torch.zeros(1, 5))

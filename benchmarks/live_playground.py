@@ -1,0 +1,103 @@
+"""The live playground in headless Chromium: bytes and time to the first result, and per Run.
+
+    python benchmarks/live_playground.py [--book _build/html] [--profile book] [--runs 20]
+
+Takes the built book (``jupyter-book build .``), writes the profile's models and test episodes
+into a copy of it (``pgae_lite.web.assets.export_web``, from the cache), serves the copy from
+localhost with every other request refused (the network off) and opens chapter 08 in Debian's
+Chromium, each time in a fresh browser context (an empty cache), once per model:
+
+- ``bytes_to_first_result``: every response body the page received from navigation until the
+  first ``window.pgae.run`` of that model resolved (the page, its scripts and styles, onnxruntime-web,
+  the manifest, the episodes, the model); ``live_bytes``: the share of it that the live playground
+  alone asked for (``_static/ort/``, ``_static/web/``, ``pgae*.js``);
+- ``seconds_to_first_result``: from navigation start to that first result;
+- ``seconds_per_run``: the median of ``--runs`` further runs on other test episodes.
+
+Writes results/live_playground.json. The budget (issue 47): the closed-vocabulary playground
+answers within 3 s of opening the page and adds at most 20 MB.
+"""
+from __future__ import annotations
+
+import functools
+import shutil
+import statistics
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+from harness import ROOT, Benchmark
+
+sys.path.insert(0, str(ROOT / "tests"))
+from test_book_browser import CHROMIUM, CHROMIUM_FLAGS, _QuietHandler, _QuietServer  # noqa: E402
+
+from pgae_lite.web.assets import export_web  # noqa: E402
+
+LIVE = ("/_static/ort/", "/_static/web/", "/_static/pgae")
+
+
+def measure(site: str, browser, model: str, runs: int) -> dict:
+    context = browser.new_context()
+    received: list[tuple[str, int]] = []
+    context.route("**/*", lambda r: r.continue_() if r.request.url.startswith(site) else r.abort())
+    page = context.new_page()
+
+    def body_size(response):
+        try:
+            received.append((response.url, len(response.body())))
+        except Exception:  # noqa: BLE001 -- a redirect or an aborted response has no body
+            pass
+    page.on("response", body_size)
+    t0 = time.perf_counter()
+    page.goto(f"{site}/notebooks/08_playground.html", wait_until="domcontentloaded")
+    episodes = page.evaluate("window.pgae.load().then(m => m.episodes.map(e => e.id))")
+    page.evaluate("([model, episode]) => window.pgae.run({model, signal: 'execute', episode})", [model, episodes[0]])
+    first = time.perf_counter() - t0
+    page.wait_for_timeout(200)                                    # responses still being counted
+    total = sum(n for _, n in received)
+    live = sum(n for url, n in received if any(part in url for part in LIVE))
+    per_run = []
+    for episode in episodes[1:runs + 1]:
+        t = time.perf_counter()
+        page.evaluate("([model, episode]) => window.pgae.run({model, signal: 'execute', episode})", [model, episode])
+        per_run.append(time.perf_counter() - t)
+    context.close()
+    return {"model": model, "bytes_to_first_result": total, "live_bytes": live,
+            "seconds_to_first_result": round(first, 3), "seconds_per_run": round(statistics.median(per_run), 4),
+            "runs": len(per_run)}
+
+
+def main() -> None:
+    bench = Benchmark("live_playground", __doc__)
+    bench.parser.add_argument("--book", default=str(ROOT / "_build" / "html"), help="the built book")
+    bench.parser.add_argument("--runs", type=int, default=20, help="runs timed after the first, per model")
+    args = bench.parse()
+    from playwright.sync_api import sync_playwright
+
+    with tempfile.TemporaryDirectory() as tmp:
+        site_dir = Path(tmp) / "html"
+        shutil.copytree(args.book, site_dir)
+        shutil.rmtree(site_dir / "_static" / "web", ignore_errors=True)
+        manifest = export_web(site_dir / "_static" / "web", args.profile, args.seeds[0])
+        files = {p.relative_to(site_dir / "_static").as_posix(): p.stat().st_size
+                 for folder in ("web", "ort") for p in (site_dir / "_static" / folder).rglob("*") if p.is_file()}
+        server = _QuietServer(("127.0.0.1", 0), functools.partial(_QuietHandler, directory=str(site_dir)))
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        site = f"http://127.0.0.1:{server.server_address[1]}"
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            models = [measure(site, browser, name, args.runs) for name in manifest["models"]]
+            browser.close()
+        server.shutdown()
+    for m in models:
+        print(m, flush=True)
+    bench.write({"models": models, "files": files, "episodes": len(manifest["episodes"]),
+                 "budget": {"seconds_to_first_result": 3.0, "live_megabytes": 20.0},
+                 "within_budget": all(m["seconds_to_first_result"] <= 3.0 and m["live_bytes"] <= 20e6
+                                      for m in models)})
+
+
+if __name__ == "__main__":
+    main()
