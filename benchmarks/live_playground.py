@@ -19,19 +19,17 @@ answers within 3 s of opening the page and adds at most 20 MB.
 """
 from __future__ import annotations
 
-import functools
 import shutil
 import statistics
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
 from harness import ROOT, Benchmark
 
 sys.path.insert(0, str(ROOT / "tests"))
-from test_book_browser import CHROMIUM, CHROMIUM_FLAGS, _QuietHandler, _QuietServer  # noqa: E402
+from browser_support import CHROMIUM, CHROMIUM_FLAGS, serve  # noqa: E402
 
 from pgae_lite.web.assets import export_web  # noqa: E402
 
@@ -83,9 +81,7 @@ def main() -> None:
         manifest = export_web(site_dir / "_static" / "web", args.profile, args.seeds[0])
         files = {p.relative_to(site_dir / "_static").as_posix(): p.stat().st_size
                  for folder in ("web", "ort") for p in (site_dir / "_static" / folder).rglob("*") if p.is_file()}
-        server = _QuietServer(("127.0.0.1", 0), functools.partial(_QuietHandler, directory=str(site_dir)))
-        threading.Thread(target=server.serve_forever, daemon=True).start()
-        site = f"http://127.0.0.1:{server.server_address[1]}"
+        site, server = serve(site_dir)
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
             models = [measure(site, browser, name, args.runs) for name in manifest["models"]]

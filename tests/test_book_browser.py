@@ -29,35 +29,19 @@ import functools
 import json
 import os
 import re
-import shutil
-import threading
 import time
 import urllib.error
 import urllib.request
-from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 import pytest
 import yaml
 
+from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve
+
 ROOT = Path(__file__).resolve().parents[1]
 BOOK = ROOT / "_build" / "html"
 SCREENSHOTS = ROOT / "_build" / "screenshots"
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
-# Flags for Chromium as root on a machine without network: no sandbox, no GPU, none
-# of its background traffic (updates, sync, first-run pages), no proxy between it and
-# localhost. Playwright gives every launch a fresh temporary profile (--user-data-dir).
-CHROMIUM_FLAGS = [
-    "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync",
-    "--no-proxy-server",
-]
-# Console errors we accept, each with the reason.
-KNOWN_CONSOLE_ERRORS = [
-    # sphinx-thebe 0.3.1 declares THEBE_JS_URL twice on every page: harmless, the live
-    # code button still works (the thebe library itself is fetched only when clicked).
-    re.compile(r"Identifier 'THEBE_JS_URL' has already been declared"),
-]
 
 
 def _missing_browser() -> str | None:
@@ -103,23 +87,13 @@ REPORT: dict[str, dict] = {}
 @pytest.fixture(scope="module")
 def site():
     """The built book served on a free localhost port, in a thread."""
-    handler = functools.partial(_QuietHandler, directory=str(BOOK))
-    server = _QuietServer(("127.0.0.1", 0), handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    yield f"http://127.0.0.1:{server.server_address[1]}"
+    address, server = serve(BOOK)
+    yield address
     server.shutdown()
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     (SCREENSHOTS / "report.json").write_text(json.dumps(REPORT, indent=1), encoding="utf-8")
 
 
-class _QuietHandler(SimpleHTTPRequestHandler):
-    def log_message(self, *args):  # keep pytest's output readable
-        pass
-
-
-class _QuietServer(ThreadingHTTPServer):
-    def handle_error(self, request, client_address):
-        pass  # the browser drops connections it no longer needs (broken pipes): not a failure
 
 
 @pytest.fixture(scope="module")

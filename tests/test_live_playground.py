@@ -23,8 +23,7 @@ BOOK = Path(os.environ.get("PGAE_LIVE_SITE", ROOT / "_build" / "html"))
 if not (BOOK / "_static" / "web" / "manifest.json").exists():
     pytest.skip(f"no live playground in {BOOK}: build the book first", allow_module_level=True)
 
-from test_book_browser import (CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, _QuietHandler,  # noqa: E402
-                               _QuietServer)
+from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve  # noqa: E402
 
 from pgae_lite.model.signals import make_batch, signal_ids  # noqa: E402
 from pgae_lite.world.words import TEST_SIGNALS, LanguageError, decode, parse_description  # noqa: E402
@@ -35,14 +34,11 @@ PAGE = "notebooks/08_playground.html"
 
 @pytest.fixture(scope="module")
 def page():
-    import functools
-    import threading
-
+    if not Path(CHROMIUM).exists():
+        pytest.skip(f"no Chromium at {CHROMIUM}")
     from playwright.sync_api import sync_playwright
 
-    server = _QuietServer(("127.0.0.1", 0), functools.partial(_QuietHandler, directory=str(BOOK)))
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    site = f"http://127.0.0.1:{server.server_address[1]}"
+    site, server = serve(BOOK)
     errors = []
     with sync_playwright() as p:
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
