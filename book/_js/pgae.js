@@ -17,7 +17,7 @@
 (function () {
   "use strict";
   const BASE = new URL(".", document.currentScript.src);        // .../_static/
-  let manifest = null, episodes = null, ortReady = null;
+  let manifest = null, episodes = null, loading = null;
   const sessions = {}, tables = {};
 
   const pyrepr = (s) => (s.includes("'") ? `"${s}"` : `'${s}'`);   // Python's repr of a string
@@ -36,19 +36,20 @@
     return r;
   }
 
-  async function load() {
-    if (!manifest) {
-      manifest = await (await fetchOk(new URL("web/manifest.json", BASE))).json();
-      episodes = new Float32Array(await (await fetchOk(new URL(`web/${manifest.episodes_file}`, BASE))).arrayBuffer());
-    }
-    if (!ortReady) {
-      ortReady = loadScript(new URL("ort/ort.wasm.min.js", BASE).href).then(() => {
+  // Everything the page needs before a first run, fetched once however many callers ask at once.
+  function load() {
+    loading = loading || (async () => {
+      const ortReady = loadScript(new URL("ort/ort.wasm.min.js", BASE).href).then(() => {
         ort.env.wasm.wasmPaths = new URL("ort/", BASE).href;
         ort.env.wasm.numThreads = 1;                              // a plain static server: no threads
       });
-    }
-    await ortReady;
-    return manifest;
+      const m = await (await fetchOk(new URL("web/manifest.json", BASE))).json();
+      episodes = new Float32Array(await (await fetchOk(new URL(`web/${m.episodes_file}`, BASE))).arrayBuffer());
+      await ortReady;
+      manifest = m;
+      return manifest;
+    })();
+    return loading;
   }
 
   async function session(name) {
@@ -179,8 +180,11 @@
 
   // The recorded joints of an episode (steps, 5), in the data's units: what execute should write.
   function recorded(episode) {
-    const ep = manifest.episodes.find(e => e.id === episode), at = ep.offset + 35 * ep.steps, out = [];
-    for (let t = 0; t < ep.steps; t++) out.push(Array.from(episodes.subarray(at + 5 * t, at + 5 * (t + 1))));
+    const ep = manifest.episodes.find(e => e.id === episode), [lo, hi] = manifest.joint_units, out = [];
+    for (let t = 0; t < ep.steps; t++) {
+      const at = ep.offset + 35 * t + 30;                             // [v_t (30); j_t (5)], j_t normalised
+      out.push(Array.from(episodes.subarray(at, at + 5), v => (v + 1) * (hi - lo) / 2 + lo));
+    }
     return out;
   }
 

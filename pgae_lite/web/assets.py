@@ -4,10 +4,11 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
 :func:`export_web` writes, from the cache (no retraining when the chapters trained them)::
 
     models/NAME.onnx      each model's :class:`~pgae_lite.web.export.EpisodeGraph`
-    models/NAME.table     PGAE-BERT only: its features of the 869 fixed inputs, float32 (869, D),
+    models/NAME.table     PGAE-BERT only: its features of the 581 fixed inputs the playground's signals
+                          read (all but repeat both's), float32 (581, D),
                           row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
     episodes.bin          every test episode, normalised as the model reads it, float32:
-                          action input (T, 35), then recorded joints in data units (T, 5)
+                          action input (T, 35): [v_t; j_t] per step
     manifest.json         the vocabulary, signals, models, the episodes' index, the normaliser's
                           joint units, and the file sizes
 
@@ -46,14 +47,13 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser) -> tuple[np.ndarray, li
     for i in range(len(test)):
         n = int(test.lengths[i])
         action = torch.cat([vision[i, :n], joints[i, :n]], 1).numpy().astype(np.float32)   # (n, 35)
-        recorded = test.joints[i, :n].astype(np.float32)                                  # (n, 5) data units
         p = Pattern.from_number(int(test.pattern[i]))
         words = [VOCABULARY[w] for w in test.descriptions[i, 0] if w]            # its first description
         index.append({"id": str(test.ids[i]), "pattern": int(test.pattern[i]), "steps": n, "offset": at,
                       "description": " ".join(words), "scene": [p.left, p.right],
                       "meaning": [p.action, p.colour, p.speed]})
-        chunks += [action.ravel(), recorded.ravel()]
-        at += action.size + recorded.size
+        chunks.append(action.ravel())
+        at += action.size
     return np.concatenate(chunks), index
 
 
@@ -64,6 +64,9 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
     prof = get_profile(profile)
     data = simulated_dataset(prof.name, "cpu", progress=progress)
     models, normaliser = {}, None
+    # the fixed inputs the playground's signals read (not "repeat both", a training signal)
+    rows = fixed_token_rows()
+    rows = rows[rows[:, 0] != SIGNAL_TOKEN + SIGNALS.index("repeat both")]          # (581, 5)
     for name, training in MODELS.items():
         run = trained_pgae(training, prof.name, seed, device="cpu", progress=progress)
         model = run.model.cpu().eval()
@@ -75,7 +78,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
                  "reads": "features" if model.language_encoder.reads_free_text else "tokens"}
         if entry["reads"] == "features":
             with torch.no_grad():
-                table = model.language_encoder(fixed_token_rows()).numpy().astype(np.float32)   # (869, D)
+                table = model.language_encoder(rows).numpy().astype(np.float32)   # (rows, D)
             with atomic_write(out / "models" / f"{name}.table") as f:
                 f.write(table.tobytes())
             entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
@@ -90,7 +93,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         "sees_action": [bool(x) for x in ACTION_IN], "describe": SIGNALS.index("describe"),
         "repeat_language": SIGNALS.index("repeat language"), "signal_token": SIGNAL_TOKEN, "eos": EOS,
         "models": models, "episodes": episodes, "episodes_file": "episodes.bin", "joint_units": list(normaliser.joints),
-        "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(fixed_token_rows().tolist())},
+        "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
     }
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
