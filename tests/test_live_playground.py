@@ -121,6 +121,15 @@ def test_bad_input_gets_the_sentence_python_gives(page, args, python):
     assert message == str(expected.value)
 
 
+def test_free_text_for_pgae_bert_says_the_page_reads_descriptions_only(page):
+    pg, _ = page
+    message = pg.evaluate("""async (args) => {
+        try { await window.pgae.run(args); return null; } catch (e) { return e.message; } }""",
+                          {"model": "PGAE-BERT", "signal": "execute", "episode": MANIFEST["episodes"][0]["id"],
+                           "text": "please push the red block away"})
+    assert message.startswith("PGAE-BERT reads any sentence in Python") and "descriptions only" in message
+
+
 def test_unknown_model_signal_and_episode_are_refused(page):
     pg, _ = page
     ask = """async (args) => { try { await window.pgae.run(args); return null; } catch (e) { return e.message; } }"""

@@ -109,6 +109,17 @@
     return tokens;
   }
 
+  // A typed text as a description; PGAE-BERT reads free text in Python, not yet in this page: said so.
+  function readDescription(model, text) {
+    try {
+      return parseDescription(text);
+    } catch (e) {
+      if (manifest.models[model].reads !== "features") throw e;
+      throw new Error(`${model} reads any sentence in Python (pgae_lite.robot.playground.play), but this page ` +
+                      `reads descriptions only so far (action colour speed): ${e.message}`);
+    }
+  }
+
   // One episode's inputs under one signal, as make_batch builds them (no opposite view).
   function inputs(ep, s, words) {
     const n = ep.steps, at = ep.offset, step = (t) => episodes.subarray(at + 35 * t, at + 35 * (t + 1));
@@ -160,7 +171,8 @@
     const ep = manifest.episodes.find(e => e.id === episode);
     if (!ep) throw new Error(`no test episode ${pyrepr(String(episode))}; e.g. ${manifest.episodes[0].id}`);
     text = (text || "").trim();
-    const words = (text ? parseDescription(text) : ep.description.split(" ")).map(w => manifest.vocabulary.indexOf(w));
+    const words = (text ? readDescription(model, text) : ep.description.split(" "))
+      .map(w => manifest.vocabulary.indexOf(w));
     if (text && !manifest.reads_words[s]) {
       throw new Error(`${pyrepr(manifest.signals[s])} reads no words: a text only picks the episode here, ` +
                       "so choose the episode instead");
