@@ -152,3 +152,23 @@ def test_the_widget_runs_in_the_page(page):
     Path(ROOT / "_build" / "screenshots").mkdir(parents=True, exist_ok=True)
     widget.screenshot(path=str(ROOT / "_build" / "screenshots" / "live_playground.png"))
     assert not errors, errors
+
+
+def test_the_pages_forward_kinematics_is_the_simulators(page):
+    from pgae_lite.sim.record import scene_layout
+    from pgae_lite.sim.robot import JOINT_LIMITS
+    from pgae_lite.sim.scene import Scene
+
+    pg, _ = page
+    rng = np.random.default_rng(0)
+    poses = [[float(rng.uniform(lo, hi)) for lo, hi in JOINT_LIMITS] for _ in range(8)]
+    tips = pg.evaluate("(poses) => poses.map(q => window.pgae.fk(q)[3])", poses)
+    scene = Scene(scene_layout(0))
+    try:
+        for q, tip in zip(poses, tips):
+            assert np.abs(np.array(tip) - scene.nico.forward_kinematics(np.array(q))).max() < 1e-5, q
+    finally:
+        scene.close()
+    episode = MANIFEST["episodes"][0]
+    layout = scene_layout(episode["pattern"], int(episode["id"].rsplit("-", 1)[1]))
+    assert np.allclose(episode["cubes"], [layout.left_xy, layout.right_xy])

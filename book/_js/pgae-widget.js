@@ -58,6 +58,34 @@
     });
   }
 
+  // NICO from above (x forward, up the page; y to NICO's left, to the left): the table, the cubes
+  // where the recording has them, the fingertip's path (model dashed, recording solid) and the arm
+  // at the model's last step, by forward kinematics of the model's own joint angles.
+  function plotArm(canvas, episode, joints, wanted) {
+    const m = window.pgae.manifest(), a = m.arm, g = canvas.getContext("2d"), W = canvas.width, H = canvas.height;
+    const back = a.shoulder[0] - 0.05, scale = (H - 30) / (a.table_x[1] + 0.02 - back);   // NICO's shoulder in view
+    const X = (p) => W / 2 - p[1] * scale, Y = (p) => H - 10 - (p[0] - back) * scale;
+    g.clearRect(0, 0, W, H);
+    g.fillStyle = "#eee3d2";
+    g.fillRect(X([0, a.table_half_width]), Y([a.table_x[1], 0]), 2 * a.table_half_width * scale,
+               (a.table_x[1] - a.table_x[0]) * scale);
+    episode.cubes.forEach((xy, k) => {
+      const [r, gr, b] = m.cube_rgba[episode.scene[k]], s = a.cube_size * scale;
+      g.fillStyle = `rgb(${255 * r}, ${255 * gr}, ${255 * b})`;
+      g.fillRect(X(xy) - s / 2, Y(xy) - s / 2, s, s);
+    });
+    [[wanted, []], [joints, [5, 4]]].forEach(([series, dash]) => {
+      g.setLineDash(dash); g.strokeStyle = "#333"; g.beginPath();
+      series.forEach((q, t) => { const tip = window.pgae.fk(q)[3]; t ? g.lineTo(X(tip), Y(tip)) : g.moveTo(X(tip), Y(tip)); });
+      g.stroke();
+    });
+    g.setLineDash([]); g.strokeStyle = "#1f77b4"; g.lineWidth = 4; g.beginPath();
+    window.pgae.fk(joints[joints.length - 1]).forEach((p, k) => (k ? g.lineTo(X(p), Y(p)) : g.moveTo(X(p), Y(p))));
+    g.stroke(); g.lineWidth = 1;
+    g.fillStyle = "#333"; g.font = "11px sans-serif";
+    g.fillText("NICO from above: fingertip path (model dashed, target solid), arm at the last step", 5, 12);
+  }
+
   window.pgaeWidget = async function (root) {
     root.textContent = "Loading the models (onnxruntime-web)...";
     let manifest;
@@ -77,9 +105,10 @@
     const said = element("pre", {class: "pgae-live-said"});
     const joints = element("canvas", {width: "640", height: "260"});
     const gate = element("canvas", {width: "640", height: "120"});
+    const arm = element("canvas", {width: "640", height: "300"});
     root.textContent = "";
     [model, signal, episode, text, button].forEach(c => root.appendChild(c));
-    [said, joints, gate].forEach(c => root.appendChild(c));
+    [said, joints, gate, arm].forEach(c => root.appendChild(c));
     button.addEventListener("click", async () => {
       button.disabled = true;
       said.classList.remove("pgae-live-error");
@@ -91,6 +120,8 @@
           `words: ${r.words || "<EOS>"}\ncomputed in this page in ${(performance.now() - t0).toFixed(0)} ms`;
         plotJoints(joints, r.joints, target(window.pgae.recorded(episode.value), signal.value));
         plotGate(gate, r.gate);
+        const wanted = target(window.pgae.recorded(episode.value), signal.value);
+        plotArm(arm, manifest.episodes.find(e => e.id === episode.value), r.joints, wanted);
         root.dataset.result = JSON.stringify(r);
       } catch (e) {
         said.textContent = `Cannot run this: ${e.message}`;

@@ -9,8 +9,9 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
                           row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
     episodes.bin          every test episode, normalised as the model reads it, float32:
                           action input (T, 35): [v_t; j_t] per step
-    manifest.json         the vocabulary, signals, models, the episodes' index, the normaliser's
-                          joint units, and the file sizes
+    manifest.json         the vocabulary, signals, models, the episodes' index (with where each
+                          episode's cubes lay), the normaliser's joint units, NICO's arm for forward
+                          kinematics, and the file sizes
 
 The page (``book/_js/pgae.js``) builds each signal's inputs from these as
 :func:`pgae_lite.model.signals.make_batch` does, runs the graph with onnxruntime-web and
@@ -32,6 +33,8 @@ from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.runs.trainings import PHRASINGS
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
+from pgae_lite.sim.record import scene_layout
+from pgae_lite.world.colours import CUBE_RGBA
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY
 
@@ -39,7 +42,17 @@ from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, S
 MODELS = {"PGAE": "PGAE", "PGAE-BERT": "PGAE-BERT", "PGAE-BERT-phrasings": PHRASINGS}
 
 
-def _episodes(test: PGAEDataset, normaliser: Normaliser) -> tuple[np.ndarray, list[dict]]:
+def _arm() -> dict:
+    """NICO's left arm as the simulator builds it (:func:`pgae_lite.sim.robot.nico_urdf`), for forward
+    kinematics in the page, and the table the cubes stand on (metres, NICO's frame = the world's)."""
+    from pgae_lite.sim.robot import FINGERTIP, FOREARM, SHOULDER, UPPER_ARM
+    from pgae_lite.sim.scene import CUBE_SIZE, TABLE_HALF_WIDTH, TABLE_X
+
+    return {"shoulder": list(SHOULDER), "upper_arm": UPPER_ARM, "forearm": FOREARM, "fingertip": FINGERTIP,
+            "table_x": list(TABLE_X), "table_half_width": TABLE_HALF_WIDTH, "cube_size": CUBE_SIZE}
+
+
+def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.ndarray, list[dict]]:
     """The test episodes as one float32 array and an index (offsets in floats)."""
     tensors = normaliser.tensors(test)
     vision, joints = tensors["vision"], tensors["joints"]                     # (N, T, 30), (N, T, 5)
@@ -49,9 +62,12 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser) -> tuple[np.ndarray, li
         action = torch.cat([vision[i, :n], joints[i, :n]], 1).numpy().astype(np.float32)   # (n, 35)
         p = Pattern.from_number(int(test.pattern[i]))
         words = [VOCABULARY[w] for w in test.descriptions[i, 0] if w]            # its first description
+        variation = int(str(test.ids[i]).rsplit("-", 1)[1])                  # "sim/PPP-V"
+        layout = scene_layout(int(test.pattern[i]), variation, config.base_seed, config.sim)   # where the cubes lay
         index.append({"id": str(test.ids[i]), "pattern": int(test.pattern[i]), "steps": n, "offset": at,
                       "description": " ".join(words), "scene": [p.left, p.right],
-                      "meaning": [p.action, p.colour, p.speed]})
+                      "meaning": [p.action, p.colour, p.speed],
+                      "cubes": [list(layout.left_xy), list(layout.right_xy)]})
         chunks.append(action.ravel())
         at += action.size
     return np.concatenate(chunks), index
@@ -83,7 +99,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
                 f.write(table.tobytes())
             entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
         models[name] = entry
-    values, episodes = _episodes(data.split("test"), normaliser)
+    values, episodes = _episodes(data.split("test"), normaliser, prof.data)
     with atomic_write(out / "episodes.bin") as f:
         f.write(values.tobytes())
     manifest = {
@@ -94,6 +110,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         "repeat_language": SIGNALS.index("repeat language"), "signal_token": SIGNAL_TOKEN, "eos": EOS,
         "models": models, "episodes": episodes, "episodes_file": "episodes.bin", "joint_units": list(normaliser.joints),
         "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
+        "arm": _arm(), "cube_rgba": {c: list(v) for c, v in CUBE_RGBA.items()},
     }
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
