@@ -111,14 +111,11 @@ needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(p) is None
 
 @pytest.fixture(scope="module")
 def bert(smoke_episodes):
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
-    from pgae_lite.train.loop import train
+    """The smoke data, its CAE and the pipeline's PGAE-BERT (cached)."""
+    from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
 
-    data = simulated_dataset("smoke", "cpu", progress=False)
-    cae, _ = trained_cae("smoke", "cpu", progress=False)
-    profile = get_profile("smoke")
-    profile.model.language_encoder = "pretrained"
-    return data, cae, train(data, profile, device="cpu", progress=False)
+    return (simulated_dataset("smoke", "cpu", progress=False), trained_cae("smoke", "cpu", progress=False)[0],
+            trained_pgae("PGAE-BERT", "smoke", 0, device="cpu", progress=False))
 
 
 @needs_bert

@@ -97,9 +97,8 @@ def _scene_text(scene: tuple[str, str]) -> str:
     return f"the cubes here are {scene[0]} (left) and {scene[1]} (right)"
 
 
-def _more_than_one(read: str, lexicon: PhraseLexicon, negated_speeds: list[str]) -> str | None:
-    """What makes ``read`` more than one instruction ("2 actions (push, pull)", "2 steps"), or None."""
-    said = slot_meanings(read, lexicon)
+def _more_than_one(read: str, said: dict, lexicon: PhraseLexicon, negated_speeds: list[str]) -> str | None:
+    """What makes ``read`` (its phrases ``said``) more than one instruction ("2 actions (push, pull)"), or None."""
     # Actions are counted by their verbs: a direction word may be a manner ("drag it right away").
     by_verbs = slot_meanings(read, replace(lexicon, directions={a: () for a in lexicon.directions}))["action"]
     speeds = [s for s in said["speed"] if s not in negated_speeds]
@@ -110,7 +109,7 @@ def _more_than_one(read: str, lexicon: PhraseLexicon, negated_speeds: list[str])
     return f"{len(steps)} steps" if len(steps) > 1 else None
 
 
-def _outside_the_world(text: str, read: str, lookup: WordLookup, swapped: dict[str, str],
+def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swapped: dict[str, str],
                        scene: tuple[str, str] | None) -> str | None:
     """A colour or an action the world does not have, said as what the robot can do; or None."""
     outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
@@ -118,17 +117,17 @@ def _outside_the_world(text: str, read: str, lookup: WordLookup, swapped: dict[s
     if outside:
         return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
                 f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))
-    if not slot_meanings(read, lookup.lexicon)["action"]:
+    if not said["action"]:
         verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w) and wordnet().synsets(w, pos="v")]
         what = f"'{verbs[0]}' a cube" if verbs else f"do {text.strip()!r}"
         return f"I can't {what}: I can {ACTIONS_SAID}"
     return None
 
 
-def _absent_cube(read: str, lexicon: PhraseLexicon, swapped: dict[str, str], scene: tuple[str, str],
+def _absent_cube(said: dict, lexicon: PhraseLexicon, swapped: dict[str, str], scene: tuple[str, str],
                  understood: str | None) -> str | None:
     """A cube named (or, where the words name none, understood) that is not on the table; or None."""
-    named = slot_meanings(read, lexicon)["colour"]
+    named = said["colour"]
     for colour in dict.fromkeys(named):
         if colour not in scene:
             word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
@@ -156,13 +155,14 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
     if negations:
         return (f"I can't do {text.strip()!r}: it says what not to do ({negations[0]!r}); tell me what to do, "
                 f"e.g. 'push the {scene[0] if scene else 'red'} cube slowly'")
-    several = _more_than_one(read, lookup.lexicon, negated_speeds)
+    said = slot_meanings(read, lookup.lexicon)                         # the actions, cubes and speeds it names
+    several = _more_than_one(read, said, lookup.lexicon, negated_speeds)
     if several:
         return f"one instruction at a time: {text.strip()!r} asks for {several}; tell me one action on one cube"
-    outside = _outside_the_world(text, read, lookup, swapped, scene)
+    outside = _outside_the_world(text, read, said, lookup, swapped, scene)
     if outside:
         return outside
-    return None if scene is None else _absent_cube(read, lookup.lexicon, swapped, scene, understood)
+    return None if scene is None else _absent_cube(said, lookup.lexicon, swapped, scene, understood)
 
 
 def disagreement(understood: str | None, pattern: int) -> str | None:
