@@ -114,7 +114,7 @@ LAYERS = {
     "exercises": {"train", "evaluate", "model", "data", "sim", "world", "util"},
     "runs": {"config", "train", "evaluate", "bert", "model", "cae", "data", "sim", "world", "util"},
     "robot": {"runs", "config", "evaluate", "bert", "model", "cae", "data", "sim", "viz", "world", "util"},
-    "web": {"runs", "config", "train", "evaluate", "bert", "model", "data", "sim", "world", "util"},
+    "web": {"robot", "runs", "config", "train", "evaluate", "bert", "model", "data", "sim", "world", "util"},
     "__main__": {"runs", "config", "data", "util"},
     "pgae_lite": set(),
 }

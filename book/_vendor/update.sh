@@ -13,18 +13,20 @@ cd "$(dirname "${BASH_SOURCE[0]}")"
 MATHJAX=3.2.2                  # MathJax 3, what Sphinx 7 targets
 HTML_MANAGER=1.0.15            # @jupyter-widgets/html-manager for ipywidgets 8
 ORT=1.30.0                     # onnxruntime-web: the live playground runs the models (book/_js/pgae.js)
+TOKENIZERS=0.2.0               # @huggingface/tokenizers: free text in the page, tokenized as in Python
 
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 # `npm pack` fetches just the published tarballs (no dependencies, no install scripts).
 npm pack --silent --pack-destination "$tmp" "mathjax@$MATHJAX" "@jupyter-widgets/html-manager@$HTML_MANAGER" \
-    "onnxruntime-web@$ORT" >/dev/null
-mkdir "$tmp/mathjax" "$tmp/widgets" "$tmp/ort"
+    "onnxruntime-web@$ORT" "@huggingface/tokenizers@$TOKENIZERS" >/dev/null
+mkdir "$tmp/mathjax" "$tmp/widgets" "$tmp/ort" "$tmp/tokenizers"
 tar xzf "$tmp"/mathjax-*.tgz -C "$tmp/mathjax" --strip-components=1
 tar xzf "$tmp"/jupyter-widgets-html-manager-*.tgz -C "$tmp/widgets" --strip-components=1
 tar xzf "$tmp"/onnxruntime-web-*.tgz -C "$tmp/ort" --strip-components=1
+tar xzf "$tmp"/huggingface-tokenizers-*.tgz -C "$tmp/tokenizers" --strip-components=1
 
-rm -rf mathjax widgets ort
+rm -rf mathjax widgets ort tokenizers
 # MathJax: the *full* TeX bundle has every TeX extension built in, so nothing is
 # loaded lazily ("autoload") at reading time; plus the CHTML fonts it asks for,
 # found relative to the script (output/chtml/fonts/woff-v2).
@@ -45,5 +47,11 @@ mkdir ort
 cp "$tmp/ort/dist/ort.wasm.min.js" "$tmp/ort/dist/ort-wasm-simd-threaded.mjs" \
    "$tmp/ort/dist/ort-wasm-simd-threaded.wasm" "$tmp/ort/package.json" ort/
 
-find mathjax widgets ort -type f | LC_ALL=C sort | xargs sha256sum > SHA256SUMS
-echo "vendored mathjax@$MATHJAX, @jupyter-widgets/html-manager@$HTML_MANAGER, onnxruntime-web@$ORT: $(du -sh --exclude=update.sh . | cut -f1)"
+# @huggingface/tokenizers: the minified ES module alone (no dependencies), loaded by pgae.js only when a
+# reader types free text; its licence (Apache-2.0) beside it.
+mkdir tokenizers
+cp "$tmp/tokenizers/dist/tokenizers.min.mjs" "$tmp/tokenizers/LICENSE" "$tmp/tokenizers/package.json" tokenizers/
+
+find mathjax widgets ort tokenizers -type f | LC_ALL=C sort | xargs sha256sum > SHA256SUMS
+echo "vendored mathjax@$MATHJAX, @jupyter-widgets/html-manager@$HTML_MANAGER, onnxruntime-web@$ORT," \
+     "@huggingface/tokenizers@$TOKENIZERS: $(du -sh --exclude=update.sh . | cut -f1)"

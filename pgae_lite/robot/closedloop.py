@@ -151,6 +151,7 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
     sim = _simulation(config)
     frame = _start(sim, config, pattern, variation, render=True)
     measured, frames, targets = [sim.joints()], [frame], [np.array(HOME_POSE)]
+    cubes = [sim.cube_positions()]                                 # (2, 3) per step, for the book's page
     v = features(frame)
     j = torch.from_numpy(normaliser.joints_to_model(measured[0])).to(device)[None]   # j_0 (1, 5)
     batch = execute_batch(v[0], j[0], words, device)
@@ -166,9 +167,11 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
             frames.append(frame)
             targets.append(target)
             measured.append(sim.joints())
+            cubes.append(sim.cube_positions())
         v = features(frame)                                      # v_{t+k}
     return Execution(pattern, variation, np.stack(frames), normaliser.joints_to_data(torch.cat(joints)).cpu().numpy(),
-                     np.array(measured), np.array(targets), sim.cube_displacement(), sim.check(), text)
+                     np.array(measured), np.array(targets), sim.cube_displacement(), sim.check(), text,
+                     np.array(cubes))
 
 
 def open_loop(joints: np.ndarray, pattern: int, variation: int = 0, *, description: str = "",

@@ -117,6 +117,8 @@ class Execution:
     displacement: np.ndarray      # (2, 3) left and right cube (m, world frame)
     check: ActionCheck            # the pattern's action, checked for the acting agent
     description: str = ""         # the words given to the model ("" when none)
+    cubes: np.ndarray | None = None   # (T, 2, 3) left and right cube centres (m, world) after each step,
+                                      # when recorded (closed_loop); else None
 
     @property
     def passed(self) -> bool:
@@ -227,6 +229,10 @@ class Simulation:
     def cube_displacement(self) -> np.ndarray:
         """(2, 3) metres: left and right cube, since reset."""
         return self.scene.cube_displacement()
+
+    def cube_positions(self) -> np.ndarray:
+        """(2, 3) metres: the left and right cube's centres now (world frame)."""
+        return self.scene.cube_positions()
 
     def _cubes(self) -> tuple[np.ndarray, np.ndarray]:
         """Start positions of the pattern's cube and of the other cube (world, (3,) each)."""

@@ -7,6 +7,11 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
     models/NAME.table     PGAE-BERT only: its features of the 581 fixed inputs the playground's signals
                           read (all but repeat both's), float32 (581, D),
                           row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
+    models/NAME.head.onnx PGAE-BERT only: its head on the transformer's token vectors (free text)
+    models/NAME.words.json  the free-form variant only: its word lookup as a table (word_table.py)
+    models/transformer.onnx the sentence encoder's transformer, float16 weights (sentence.py)
+    tokenizer/            its tokenizer's files (tokenizer.json, tokenizer_config.json)
+    sim_runs.json         the simulator's closed-loop runs at build time (sim_runs.py), labelled so
     episodes.bin          every test episode, normalised as the model reads it, float32:
                           action input (T, 35): [v_t; j_t] per step
     manifest.json         the vocabulary, signals, models, the episodes' index (with where each
@@ -15,17 +20,19 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
 
 The page (``book/_js/pgae.js``) builds each signal's inputs from these as
 :func:`pgae_lite.model.signals.make_batch` does, runs the graph with onnxruntime-web and
-turns the joints back into data units.
+turns the joints back into data units. The free-text files (transformer, heads, tokenizer, word
+tables) are fetched only when a reader types a sentence that is not a description.
 """
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from pgae_lite.bert.pretrained import fixed_token_rows
+from pgae_lite.bert.pretrained import fixed_token_rows, tokens_to_text
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
@@ -33,6 +40,9 @@ from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.runs.trainings import PHRASINGS
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
+from pgae_lite.web.sentence import head_onnx, transformer_onnx
+from pgae_lite.web.sim_runs import simulator_runs
+from pgae_lite.web.word_table import word_table
 from pgae_lite.sim.record import scene_layout
 from pgae_lite.world.colours import CUBE_RGBA
 from pgae_lite.world.patterns import Pattern
@@ -73,13 +83,47 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.nda
     return np.concatenate(chunks), index
 
 
-def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False) -> dict:
-    """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest."""
+def _free_text(out: Path, encoders: dict, entries: dict) -> dict:
+    """The files PGAE-BERT's free text needs in the page: the shared transformer (float16 weights), its
+    tokenizer, each model's head and the variant's word table. Adds them to ``entries``; what the manifest
+    says of them."""
+    names = {encoder.name for encoder in encoders.values()}
+    if len(names) != 1:
+        raise ValueError(f"the page holds one sentence encoder, but the models read {sorted(names)}")
+    encoder = next(iter(encoders.values()))
+    transformer = transformer_onnx(encoder.transformer.model, out / "models" / "transformer.onnx")
+    tokenizer = encoder.transformer.tokenizer
+    make_folder(out / "tokenizer")
+    with tempfile.TemporaryDirectory() as tmp:                        # the fast tokenizer's own files
+        tokenizer.save_pretrained(tmp)
+        for name in ("tokenizer.json", "tokenizer_config.json"):                # without indentation
+            saved = json.loads((Path(tmp) / name).read_text(encoding="utf-8"))
+            atomic_write_text(out / "tokenizer" / name, json.dumps(saved, ensure_ascii=False, separators=(",", ":")))
+    files = len(transformer) + sum((out / "tokenizer" / n).stat().st_size
+                                   for n in ("tokenizer.json", "tokenizer_config.json"))
+    for name, encoder in encoders.items():
+        entries[name] |= {"head": f"models/{name}.head.onnx", "words": None,
+                          # the tuned variant reads a text it was trained on from its frozen table (encode_texts)
+                          "fixed_from_table": getattr(encoder, "top", None) is not None}
+        files += len(head_onnx(encoder, out / "models" / f"{name}.head.onnx"))
+        if getattr(encoder, "word_lookup", None) is not None:
+            atomic_write_text(out / "models" / f"{name}.words.json", json.dumps(word_table(encoder.word_lookup)))
+            entries[name]["words"] = f"models/{name}.words.json"
+            files += (out / "models" / f"{name}.words.json").stat().st_size
+    return {"transformer": "models/transformer.onnx", "tokenizer": "tokenizer/tokenizer.json",
+            "tokenizer_config": "tokenizer/tokenizer_config.json",
+            "max_tokens": int(min(tokenizer.model_max_length, 512)), "bytes": files}
+
+
+def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False,
+               simulate: bool = True) -> dict:
+    """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
+    ``simulate=False``: without the simulator's runs (the page then keeps the cubes where they lay)."""
     out = make_folder(out)
     make_folder(out / "models")
     prof = get_profile(profile)
     data = simulated_dataset(prof.name, "cpu", progress=progress)
-    models, normaliser = {}, None
+    models, encoders, normaliser = {}, {}, None
     # the fixed inputs the playground's signals read (not "repeat both", a training signal)
     rows = fixed_token_rows()
     rows = rows[rows[:, 0] != SIGNAL_TOKEN + SIGNALS.index("repeat both")]          # (581, 5)
@@ -98,7 +142,9 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
             with atomic_write(out / "models" / f"{name}.table") as f:
                 f.write(table.tobytes())
             entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
+            encoders[name] = model.language_encoder
         models[name] = entry
+    free_text = _free_text(out, encoders, models) if encoders else None
     values, episodes = _episodes(data.split("test"), normaliser, prof.data)
     with atomic_write(out / "episodes.bin") as f:
         f.write(values.tobytes())
@@ -110,8 +156,12 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         "repeat_language": SIGNALS.index("repeat language"), "signal_token": SIGNAL_TOKEN, "eos": EOS,
         "models": models, "episodes": episodes, "episodes_file": "episodes.bin", "joint_units": list(normaliser.joints),
         "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
+        "fixed_texts": {tokens_to_text(row): r for r, row in enumerate(rows)}, "free_text": free_text,
         "arm": _arm(), "cube_rgba": {c: list(v) for c, v in CUBE_RGBA.items()},
+        "sim_runs": "sim_runs.json" if simulate else None,
     }
+    if simulate:
+        simulator_runs(out, MODELS, prof.name, seed, progress=progress)
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
 
