@@ -1,10 +1,12 @@
-"""Command line: ``python -m pgae_lite reproduce`` and ``python -m pgae_lite simulate``.
+"""Command line: ``python -m pgae_lite reproduce``, ``simulate`` and ``export-web``.
 
 ``reproduce`` trains the chosen rows of the paper's Table 1 (PGAE, PGAE-BERT,
 PGAE-self, PGAE-opposite; resuming interrupted runs) in the chosen profile, on
 the authors' data or on our simulated data, evaluates them on the test split,
 prints the table next to the paper's rows and writes ``results.json`` and
-``predictions.npz`` to the output folder. ``simulate`` records the dataset.
+``predictions.npz`` to the output folder. ``simulate`` records the dataset. ``export-web`` writes
+the live playground's files (the trained models as ONNX, the test episodes, the simulator's runs)
+into a folder, from the cache; the book's build runs it into ``_static/web``.
 
 Every argument is checked before any data is read. A bad one, or any error of
 the package (:class:`~pgae_lite.util.errors.PGAELiteError`), prints one line
@@ -84,6 +86,16 @@ def main(argv: list[str] | None = None) -> int:
     sim.add_argument("--workers", type=int, default=None,
                      help="parallel processes, at least 1 (default: one per CPU core)")
     sim.add_argument("--no-progress", action="store_true", help="no progress bar")
+    web = sub.add_parser("export-web", help="write the live playground's files (what the book's build does)",
+                         description="Write the profile's trained models (ONNX), the sentence encoder, the test "
+                                     "episodes and the simulator's closed-loop runs into OUT, as the book's build "
+                                     "writes them into _build/html/_static/web. Models missing from the cache are "
+                                     "trained first.")
+    web.add_argument("out", metavar="OUT", help="the folder to write (created if missing)")
+    web.add_argument("--profile", choices=PROFILE_NAMES, default=None,
+                     help=f"the models' profile (default: ${PROFILE_ENV}, else 'book')")
+    web.add_argument("--no-simulator", action="store_true", help="without the simulator's runs")
+    web.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
@@ -111,6 +123,13 @@ def run_command(args: argparse.Namespace) -> int:
         if args.workers is not None:
             whole_number("--workers", args.workers, 1)
         return simulate(profile, args.workers, not args.no_progress)
+    if args.command == "export-web":
+        from pgae_lite.web.assets import export_web
+
+        manifest = export_web(args.out, profile, progress=not args.no_progress, simulate=not args.no_simulator)
+        print(f"live playground: {len(manifest['models'])} models and {len(manifest['episodes'])} test episodes "
+              f"({manifest['profile']} profile) in {args.out}")
+        return 0
     from pgae_lite.runs.reproduce import check_arguments, reproduce
 
     original = args.original_data

@@ -188,9 +188,10 @@ def test_help_does_not_import_torch():
     assert out.stdout.splitlines()[-1] == "False False"
 
 
-@pytest.mark.parametrize("command", ["simulate", "reproduce"])
+@pytest.mark.parametrize("command", ["simulate", "reproduce", "export-web"])
 def test_unknown_profile_in_the_environment_is_one_clear_line(command):
-    r = run(command, "--no-progress", env={"PGAE_LITE_PROFILE": "garbage"}, timeout=120)
+    folder = ["out"] if command == "export-web" else []                # export-web's one positional argument
+    r = run(command, *folder, "--no-progress", env={"PGAE_LITE_PROFILE": "garbage"}, timeout=120)
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.splitlines() == ["error: unknown profile 'garbage' (from the environment variable "
                                      "PGAE_LITE_PROFILE); the profiles are: smoke, book, paper"]
@@ -200,3 +201,16 @@ def test_unknown_profile_option_is_refused_by_the_parser(capsys):
     with pytest.raises(SystemExit) as e:
         main(["simulate", "--profile", "garbage"])
     assert e.value.code == 2 and "invalid choice: 'garbage'" in capsys.readouterr().err
+
+
+def test_export_web_writes_what_the_books_build_writes(smoke_episodes, tmp_path, monkeypatch, capsys):
+    """``export-web``: the playground's models, episodes and manifest, from the cache (smoke profile)."""
+    pytest.importorskip("onnxruntime")
+    monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
+    out = tmp_path / "web"
+    assert main(["export-web", str(out), "--no-simulator", "--no-progress"]) == 0
+    assert capsys.readouterr().out.startswith("live playground: 3 models and ")
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["profile"] == "smoke" and manifest["sim_runs"] is None and not (out / "sim_runs.json").exists()
+    for entry in manifest["models"].values():
+        assert (out / entry["file"]).stat().st_size == entry["bytes"]
