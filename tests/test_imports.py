@@ -115,7 +115,7 @@ LAYERS = {
     "runs": {"config", "train", "evaluate", "bert", "model", "cae", "data", "sim", "world", "util"},
     "robot": {"runs", "config", "evaluate", "bert", "model", "cae", "data", "sim", "viz", "world", "util"},
     "web": {"robot", "runs", "config", "train", "evaluate", "bert", "model", "data", "sim", "world", "util"},
-    "__main__": {"runs", "config", "data", "util"},
+    "__main__": {"web", "runs", "config", "data", "util"},
     "pgae_lite": set(),
 }
 

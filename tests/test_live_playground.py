@@ -140,28 +140,49 @@ def _texts() -> list[str]:
     return [p.text for p in load_paraphrases()] + TYPED
 
 
+def _page_runs(pg, name: str, texts: list[str], episodes: list[str]) -> list[dict]:
+    """Each text run in the page under execute on its episode: the result and the text as read, or the
+    sentence it was refused with."""
+    return pg.evaluate("""async ([model, texts, ids]) => {
+        const out = [];
+        for (let i = 0; i < texts.length; i++) {
+          try {
+            const r = await window.pgae.run({model, signal: "execute", episode: ids[i], text: texts[i]});
+            out.push({...r, read: await window.pgae.readAs(model, texts[i])});
+          } catch (e) { out.push({refused: e.message}); }
+        }
+        return out; }""", [name, texts, episodes])
+
+
 @pytest.mark.parametrize("name", FREE_MODELS)
 def test_free_text_in_the_page_is_what_pytorch_computes(page, name):
-    """Every free-form sentence of the project: the words the page writes and says back are PyTorch's, the
-    text is read as Python reads it, and the joints are within 1e-3 of the joint range (the page's
-    transformer has float16 weights)."""
+    """Every free-form sentence of the project, each on a test episode with its cube where one exists:
+    what the page writes and says back is PyTorch's, the text is read as Python reads it, the joints are
+    within 1e-3 of the joint range (the page's transformer has float16 weights), and a text Python's
+    refusal refuses is refused with its sentence."""
+    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.robot.refusals import refusal
     from pgae_lite.web.sentence import free_text_reference
 
     pg, errors = page
     model, normaliser, test = _python(name)
     texts, span = _texts(), float(normaliser.joints[1] - normaliser.joints[0])
-    want = free_text_reference(model, normaliser, test, texts)
-    got = pg.evaluate("""async ([model, texts, ids]) => {
-        const out = [];
-        for (let i = 0; i < texts.length; i++) {
-          const r = await window.pgae.run({model, signal: "execute", episode: ids[i], text: texts[i]});
-          out.push({...r, read: await window.pgae.readAs(model, texts[i])});
-        }
-        return out; }""", [name, texts, [w["episode"] for w in want]])
-    for text, r, w in zip(texts, got, want):
+    scenes = [MANIFEST["episodes"][i]["scene"] for i in range(len(test))]
+    colours = [p.colour for p in load_paraphrases()] + [None] * len(TYPED)
+    rows = [next((k for k, scene in enumerate(scenes) if c in scene), i % len(test)) for i, c in enumerate(colours)]
+    want = free_text_reference(model, normaliser, test, texts, rows)
+    got = _page_runs(pg, name, texts, [w["episode"] for w in want])
+    acted = 0
+    for text, r, w, row in zip(texts, got, want, rows):
+        why = refusal(text, model.language_encoder, tuple(scenes[row]), w["understood"])
+        if why:
+            assert r == {"refused": why}, text
+            continue
+        acted += 1
         assert r["read"] == model.language_encoder.read_as(text), text
         assert (r["words"], r["understood"]) == (w["words"], w["understood"]), text
         assert np.abs(np.array(r["joints"]) - w["joints"]).max() <= 1e-3 * span, text
+    assert acted >= len(texts) // 2, acted
     assert not errors, errors
 
 
@@ -243,4 +264,37 @@ def test_chapter_05s_box_says_what_both_models_understood(page):
         assert f"{name} understood: {r['understood']}" in said, said
     box.screenshot(path=str(ROOT / "_build" / "screenshots" / "chapter05_understood.png"))
     pg.goto(pg.url.replace("notebooks/05_pgae_bert.html", PAGE), wait_until="load")
+    assert not errors, errors
+
+
+# Instructions the robot may refuse, of each kind the rule knows (and some it acts on)
+INSTRUCTIONS = ["don't push the red cube", "please never pull the blue block", "stop sliding it",
+                "push the red cube and then pull it back", "shove it, then drag it toward you",
+                "slide the red one and the blue one", "push it slowly, no, fast", "push the black cube away",
+                "drag the orange block over", "rotate the red cube", "lift it up", "spin the block around",
+                "push the green cube away", "pull the violet one quickly", "nudge the crimson block forward",
+                "please push it away, no rush", "haul the cube towards you in a hurry", "do it"]
+
+
+@pytest.mark.parametrize("name", FREE_MODELS)
+def test_the_page_refuses_what_python_refuses(page, name):
+    """Under execute, free text gets the sentence Python's refusal gives (CannotDo), or acts with its note."""
+    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.robot.refusals import disagreement, refusal
+    from pgae_lite.web.sentence import free_text_reference
+
+    pg, errors = page
+    model, normaliser, test = _python(name)
+    texts = INSTRUCTIONS + [p.text for p in load_paraphrases()[::9]]
+    want = free_text_reference(model, normaliser, test, texts)
+    episodes = {e["id"]: e for e in MANIFEST["episodes"]}
+    got = [r.get("note") if "refused" not in r else f"refused: {r['refused']}"
+           for r in _page_runs(pg, name, texts, [w["episode"] for w in want])]
+    refused = 0
+    for text, w, r in zip(texts, want, got):
+        ep = episodes[w["episode"]]
+        why = refusal(text, model.language_encoder, tuple(ep["scene"]), w["understood"])
+        refused += why is not None
+        assert r == (f"refused: {why}" if why else disagreement(w["understood"], ep["pattern"])), text
+    assert refused >= len(INSTRUCTIONS) // 2                  # the rule ran: most of these are refused
     assert not errors, errors

@@ -17,11 +17,12 @@
 // pgae_lite.model.signals.make_batch builds them.
 //
 // Free text (a sentence that is not a description) runs the sentence encoder in the page: the
-// tokenizer (@huggingface/tokenizers, vendored in _static/tokenizers/), the transformer and the
-// model's head (pgae_lite/web/sentence.py), after the variant's word lookup read from its table
-// (pgae_lite/web/word_table.py). Those files (about 46-50 MB) are fetched on the first free text
-// only. Not here: Python's refusals (pgae_lite/robot/refusals.py reads WordNet), so the page acts
-// on a negation or two instructions where Python says it cannot.
+// tokenizer (@huggingface/tokenizers, vendored in _static/tokenizers/), the transformer below its
+// top layer and the model's head, its own top layer and pooling (pgae_lite/web/sentence.py), after the variant's word lookup read from its table
+// (pgae_lite/web/word_table.py). Those files (about 46 MB a model) are fetched on the first free
+// text only. Under execute, free text the robot will not act on (a negation, two instructions, a
+// cube that is not there: pgae_lite/robot/refusals.py) rejects with Python's sentence
+// (pgae-refusals.js), and the result's note says where the readback and the episode disagree.
 //
 //   window.pgae.readAs(model, text) -> Promise of the text as the model reads it (the variant's lookup).
 //   window.pgae.simulated(model, episode) -> Promise of null or the simulator's own closed-loop run
@@ -32,7 +33,11 @@
   let manifest = null, episodes = null, loading = null, freeText = null, simRuns = null;
   const sessions = {}, tables = {}, heads = {};
 
-  const pyrepr = (s) => (s.includes("'") ? `"${s}"` : `'${s}'`);   // Python's repr of a string
+  // Python's repr of a string: '...', or "..." when it holds a ' and no "; backslashes and breaks escaped
+  function pyrepr(s) {
+    s = s.replace(/\\/g, "\\\\").replace(/\n/g, "\\n").replace(/\r/g, "\\r").replace(/\t/g, "\\t");
+    return s.includes("'") && !s.includes('"') ? `"${s}"` : `'${s.replace(/'/g, "\\'")}'`;
+  }
 
   function loadScript(src) {
     return new Promise((done, fail) => {
@@ -121,6 +126,15 @@
     return tokens;
   }
 
+  // The canonical meaning (action, colour, speed) of a description, or null if it is none.
+  function meaningOf(text) {
+    try {
+      return parseDescription(text || "").map(token => manifest.canonical[token]);
+    } catch (e) {
+      return null;
+    }
+  }
+
   // A typed text, read once (pgae_lite.robot.typed_text.read_typed): a description's words, or null for
   // free text, which only the PGAE-BERT models read, and only under a signal that reads words.
   function readTyped(model, s, text) {
@@ -144,11 +158,15 @@
     freeText = freeText || (async () => {
       const f = manifest.free_text, url = (p) => new URL(`web/${p}`, BASE).href;
       if (!f) throw new Error("this book was built without the sentence encoder: the page reads descriptions only");
-      const [lib, json, config, transformer] = await Promise.all([
+      const [lib, json, vocab, config, transformer, shared] = await Promise.all([
         import(new URL("tokenizers/tokenizers.min.mjs", BASE).href),
-        fetchOk(url(f.tokenizer)).then(r => r.json()), fetchOk(url(f.tokenizer_config)).then(r => r.json()),
-        ort.InferenceSession.create(url(f.transformer), {executionProviders: ["wasm"]})]);
-      return {tokenizer: new lib.Tokenizer(json, config), transformer};
+        fetchOk(url(f.tokenizer)).then(r => r.json()), fetchOk(url(f.vocab)).then(r => r.text()),
+        fetchOk(url(f.tokenizer_config)).then(r => r.json()),
+        ort.InferenceSession.create(url(f.transformer), {executionProviders: ["wasm"]}),
+        fetchOk(url(f.refusals)).then(r => r.json()),
+        loadScript(new URL("pgae-refusals.js", BASE).href)]);
+      json.model.vocab = Object.fromEntries(vocab.split("\n").map((token, id) => [token, id]));   // vocab.txt: by id
+      return {tokenizer: new lib.Tokenizer(json, config), transformer, reader: window.pgaeRefusals.make(shared, pyrepr)};
     })();
     return freeText;
   }
@@ -166,6 +184,15 @@
     return wordTables[name];
   }
 
+  // One model's refusal rule (pgae-refusals.js on its refusals.json), loaded once.
+  const refusalRules = {};
+  function refusalRule(name) {
+    refusalRules[name] = refusalRules[name] || Promise.all([
+      loadFreeText(), fetchOk(new URL(`web/${manifest.models[name].refusals}`, BASE)).then(r => r.json())])
+      .then(([{reader}, data]) => reader(data));
+    return refusalRules[name];
+  }
+
   // The words of a text, as pgae_lite.bert.word_lookup splits them: letters, inner apostrophes.
   const WORD = /[\p{L}\p{Nl}\p{No}]+(?:'[\p{L}\p{Nl}\p{No}]+)*/gu;
 
@@ -175,6 +202,13 @@
     if (manifest.models[name]?.reads !== "features") return text;
     const words = await wordTable(name);
     return text.replace(WORD, w => words[w.toLowerCase()] || w);
+  }
+
+  // The words of a text the lookup replaces, [word, replacement] in the text's order (lookup.replacements).
+  async function replacements(name, text) {
+    const words = await wordTable(name);
+    return [...new Set(text.match(WORD) || [])].filter(w => words[w.toLowerCase()])
+      .map(w => [w, words[w.toLowerCase()]]);
   }
 
   // Free text's features (1, D) under signal s, as encoder.encode_texts computes them: the text after
@@ -193,11 +227,9 @@
     if (ids.length > most) ids = [...ids.slice(0, most - 1), ids[ids.length - 1]];
     const shape = [1, ids.length], ones = new BigInt64Array(ids.length).fill(1n);
     const mask = new ort.Tensor("int64", ones, shape);
-    const out = await transformer.run({input_ids: new ort.Tensor("int64", BigInt64Array.from(ids.map(BigInt)), shape),
-                                       attention_mask: mask});
-    const feeds = {last: out.last, below_top: out.below_top, mask};
-    const wanted = Object.fromEntries(graph.inputNames.map(k => [k, feeds[k]]));  // the mean reads no below_top
-    return (await graph.run(wanted)).features.data;
+    const {below_top} = await transformer.run({
+      input_ids: new ort.Tensor("int64", BigInt64Array.from(ids.map(BigInt)), shape), attention_mask: mask});
+    return (await graph.run({below_top, mask})).features.data;   // its top layer, then its pooling
   }
 
   // One episode's inputs under one signal, as make_batch builds them (no opposite view).
@@ -260,18 +292,25 @@
     }
     const words = (typed || ep.description.split(" ")).map(w => manifest.vocabulary.indexOf(w));
     const said = (signal) => (free ? sentenceFeatures(model, signal, text) : null);
-    const x = inputs(ep, s, words), out = await forward(model, x, await said(s));
-    let understood = null;
+    let understood = null, note = null;
     if (text) {                                                     // the text said back, no action shown
       const back = manifest.repeat_language;
       understood = decode((await forward(model, inputs(ep, back, words), await said(back))).logits.data);
     }
+    if (free && manifest.signals[s] === "execute") {                 // the robot acts: first, whether it can
+      const back = {words: understood, meaning: meaningOf(understood)};
+      const rule = await refusalRule(model);
+      const why = rule.refusal(text, await readAs(model, text), await replacements(model, text), ep.scene, back);
+      if (why) throw new Error(why);
+      note = window.pgaeRefusals.disagreement(back, ep.meaning, pyrepr);
+    }
+    const x = inputs(ep, s, words), out = await forward(model, x, await said(s));
     const [lo, hi] = manifest.joint_units;
     const units = (v) => (v + 1) * (hi - lo) / 2 + lo;                // [-1, 1] -> the data's units
     const joints = [Array.from(x.start, units)];
     const J = out.joints.data;
     for (let t = 0; t < x.n - 1; t++) joints.push(Array.from(J.subarray(5 * t, 5 * (t + 1)), units));
-    return {words: decode(out.logits.data), understood, joints, gate: Array.from(out.gate.data)};
+    return {words: decode(out.logits.data), understood, joints, gate: Array.from(out.gate.data), note};
   }
 
   // The recorded joints of an episode (steps, 5), in the data's units: what execute should write.

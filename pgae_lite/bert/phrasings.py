@@ -170,13 +170,9 @@ def phrasings_digest(n: int, seed: int = 0, lexicon: PhraseLexicon | None = None
                           for meaning in itertools.product(*MEANINGS.values())])
 
 
-def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
-                  ) -> dict[str, list[str]]:
-    """The meaning of each slot phrase in ``text``, by slot; longest phrases first.
-
-    Reads the lexicon's phrases only (a word it lacks says nothing); frame and
-    carrier words are skipped, so ``go ahead and`` is not the direction ``ahead``.
-    """
+def phrase_table(lexicon: PhraseLexicon | None = None) -> dict[tuple[str, ...], tuple[str, str] | None]:
+    """The phrases :func:`slot_meanings` reads: each phrase's words -> (slot, meaning), or None for the
+    frame and carrier words it skips."""
     lex = lexicon or LEXICON
     table: dict[tuple[str, ...], tuple[str, str] | None] = {
         tuple(words_of(piece)): None for frame in (*lex.frames, *lex.gerund_frames,
@@ -188,6 +184,17 @@ def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
     for action in MEANINGS["action"]:            # the -ing forms of the gerund frames
         table.update({(gerund(v),): ("action", action)
                       for v in (*lex.verbs.get(action, ()), *lex.steered.get(action, ()))})
+    return table
+
+
+def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
+                  ) -> dict[str, list[str]]:
+    """The meaning of each slot phrase in ``text``, by slot; longest phrases first.
+
+    Reads the lexicon's phrases only (a word it lacks says nothing); frame and
+    carrier words are skipped, so ``go ahead and`` is not the direction ``ahead``.
+    """
+    table = phrase_table(lexicon)
     longest = max(map(len, table))
     words, found, i = words_of(text), {slot: [] for slot in SLOTS}, 0
     while i < len(words):
@@ -203,4 +210,4 @@ def slot_meanings(text: str, lexicon: PhraseLexicon | None = None
     return found
 
 
-__all__ = ["gerund", "phrasing", "phrasings", "phrasings_digest", "slot_meanings"]
+__all__ = ["gerund", "phrase_table", "phrasing", "phrasings", "phrasings_digest", "slot_meanings"]

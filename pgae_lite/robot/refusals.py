@@ -54,6 +54,12 @@ class CannotDo(LanguageError):
     """A free instruction the robot will not act on; the message says why and what it can do."""
 
 
+def lookup_of(encoder) -> WordLookup:
+    """The lookup that reads a text's words for ``encoder``: its own, or one that knows the training words."""
+    own = getattr(encoder, "word_lookup", None)
+    return _words_only() if own is None else own
+
+
 @lru_cache(maxsize=1)
 def _words_only() -> WordLookup:
     """A lookup that knows the training lexicon and its grammar's words (20 sentences of each meaning)."""
@@ -72,7 +78,7 @@ def _reading(encoder, text: str) -> tuple[WordLookup, str, dict[str, str]]:
     return own, own.rewrite(text), own.replacements(text)
 
 
-def _is_colour_word(word: str) -> bool:
+def is_colour_word(word: str) -> bool:
     """Whether WordNet lists ``word`` as a kind of colour (``black``, ``orange``), by any sense."""
     colour = wordnet().synset("color.n.01")
     return any(s == colour or colour in s.closure(lambda x: x.hypernyms()) for s in wordnet().synsets(word))
@@ -113,7 +119,7 @@ def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swa
                        scene: tuple[str, str] | None) -> str | None:
     """A colour or an action the world does not have, said as what the robot can do; or None."""
     outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
-               and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and _is_colour_word(w)]
+               and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and is_colour_word(w)]
     if outside:
         return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
                 f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))

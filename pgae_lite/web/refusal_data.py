@@ -1,0 +1,77 @@
+"""What the robot refuses, as data for the reader's browser (not in the paper).
+
+Paper, Sec. 3: PGAE-BERT reads any text and always acts. :mod:`pgae_lite.robot.refusals` decides
+first whether the robot acts on a free instruction, from its words, the model's readback and the
+scene, reading the phrase lexicon and WordNet. The page has neither, so the build writes what the
+rule reads, and ``book/_js/pgae.js`` applies the same rule to it::
+
+    refusals.json        shared by the models:
+      negators, sequencers, clause_end, step_end   the rule's closed classes of words and its patterns
+      colours, actions_said                        the world's six colours; what the robot can do
+      colour_words       WordNet's words with a sense that is a kind of colour (refusals.is_colour_word)
+      verbs              WordNet's words with a verb sense, front-coded (:func:`front_coded`)
+    models/NAME.refusals.json   one model's reading:
+      phrases            the phrase table slot_meanings reads, [words, slot, meaning] (None: skipped)
+      phrases_by_verbs   the same with the directions left out (actions counted by their verbs)
+      known              the words of ``colour_words`` and ``verbs`` its lookup knows (is_known)
+
+The words are decided over the same candidates as the word table (:mod:`pgae_lite.web.word_table`):
+each lemma of WordNet and each form one ending away; a word outside them has no sense, so Python
+counts it as neither a colour nor a verb either.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from pgae_lite.bert.phrasings import phrase_table
+from pgae_lite.bert.word_lookup import WordLookup, wordnet
+from pgae_lite.robot import refusals
+from pgae_lite.web.word_table import candidates
+from pgae_lite.world.words import COLOURS
+
+
+def front_coded(words: list[str]) -> str:
+    """Sorted words as one string, each line the length of the prefix it shares with the line before
+    (one character, ``chr(48 + k)``, k < 40) and the rest: ``push, pushed`` -> ``"0push\\n4ed"``."""
+    lines, before = [], ""
+    for word in sorted(words):
+        k = 0
+        while k < min(len(word), len(before), 39) and word[k] == before[k]:
+            k += 1
+        lines.append(chr(48 + k) + word[k:])
+        before = word
+    return "\n".join(lines)
+
+
+def shared_words() -> dict:
+    """What every model's refusal reads: the rule's words and patterns, WordNet's colour words and verbs."""
+    dictionary = wordnet()
+    colour = dictionary.synset("color.n.01")
+    kinds = {colour} | set(colour.closure(lambda s: s.hyponyms()))     # every kind of colour
+    words = candidates(shortest=1)                                    # a verb may be short: "go"
+    return {"negators": sorted(refusals.NEGATORS), "sequencers": sorted(refusals.SEQUENCERS),
+            "clause_end": refusals._CLAUSE_END.pattern, "step_end": refusals._STEP_END.pattern,
+            "colours": list(COLOURS), "actions_said": refusals.ACTIONS_SAID,
+            "colour_words": sorted(w for w in words if len(w) >= 3 and any(s in kinds for s in dictionary.synsets(w))),
+            "verbs": front_coded([w for w in words if dictionary.synsets(w, pos="v")])}
+
+
+def _table(lexicon) -> list:
+    return [[" ".join(words), *(hit or (None, None))] for words, hit in phrase_table(lexicon).items()]
+
+
+def model_reading(encoder, shared: dict) -> dict:
+    """One model's phrase tables and the words of ``shared`` its lookup knows."""
+    lookup: WordLookup = refusals.lookup_of(encoder)
+    lexicon = lookup.lexicon
+    by_verbs = replace(lexicon, directions={a: () for a in lexicon.directions})
+    verbs = shared["verbs"].split("\n")
+    words, before = [], ""
+    for line in verbs:                                          # the front coding undone
+        before = before[:ord(line[0]) - 48] + line[1:]
+        words.append(before)
+    return {"phrases": _table(lexicon), "phrases_by_verbs": _table(by_verbs),
+            "known": sorted(w for w in (*words, *shared["colour_words"]) if lookup.is_known(w))}
+
+
+__all__ = ["front_coded", "model_reading", "shared_words"]
