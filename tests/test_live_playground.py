@@ -259,8 +259,8 @@ def test_chapter_05s_box_says_what_both_models_understood(page):
     said = box.locator("pre").inner_text()
     episode = MANIFEST["episodes"][0]["id"]
     for name in FREE_MODELS:
-        r = pg.evaluate("([model, episode, text]) => window.pgae.run({model, signal: 'execute', episode, text})",
-                        [name, episode, text])
+        r = pg.evaluate("([model, episode, text]) => window.pgae.run({model, signal: 'repeat language', episode, "
+                        "text})", [name, episode, text])
         assert f"{name} understood: {r['understood']}" in said, said
     box.screenshot(path=str(ROOT / "_build" / "screenshots" / "chapter05_understood.png"))
     pg.goto(pg.url.replace("notebooks/05_pgae_bert.html", PAGE), wait_until="load")

@@ -1,6 +1,6 @@
 // Chapter 05's live box: every element with class "pgae-understood" becomes a text box and a
 // button. On a click, both PGAE-BERT models read the typed sentence in this page
-// (window.pgae.run, pgae.js; signal execute, on the first test episode) and each says back
+// (window.pgae.run, pgae.js; signal repeat language, on the first test episode) and each says back
 // what it understood, in the dataset's words. A model that cannot read the text says why: the
 // promise's error message is shown as it is. Nothing here computes a model.
 (function () {
@@ -28,10 +28,10 @@
       try {
         const manifest = await window.pgae.load();
         const episode = manifest.episodes[0].id;                       // the first test episode
-        lines.push(`"${sentence}" (execute, test episode ${episode}), computed in this page:`);
+        lines.push(`"${sentence}" (repeat language, test episode ${episode}), computed in this page:`);
         for (const model of MODELS) {                                  // one after the other: one line each
           try {
-            const r = await window.pgae.run({model, signal: "execute", episode, text: sentence});
+            const r = await window.pgae.run({model, signal: "repeat language", episode, text: sentence});
             const read = await window.pgae.readAs(model, sentence);       // the variant's word lookup
             lines.push(`${model} understood: ${r.understood || "<EOS>"}` +
                        (read !== sentence ? ` (it read "${read}")` : ""));

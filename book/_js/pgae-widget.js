@@ -242,6 +242,7 @@
         const r = await window.pgae.run({model: model.value, signal: signal.value, episode: episode.value,
                                          text: text.value});
         said.textContent = (r.understood !== null ? `I understood: ${r.understood || "<EOS>"}\n` : "") +
+          (r.note ? `note: ${r.note}\n` : "") +
           `words: ${r.words || "<EOS>"}\ncomputed in this page in ${(performance.now() - t0).toFixed(0)} ms`;
         // The cubes move only along the simulator's own run of this model on this episode (execute).
         let sim = null, why = "";

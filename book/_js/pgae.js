@@ -4,7 +4,7 @@
 // _static/web/ (pgae_lite/web/assets.py); onnxruntime-web (WebAssembly, vendored in
 // _static/ort/) runs them here. One documented function:
 //
-//   window.pgae.run({model, signal, episode, text}) -> Promise of {words, understood, joints, gate}
+//   window.pgae.run({model, signal, episode, text}) -> Promise of {words, understood, joints, gate, note}
 //
 // model: a name the playground offers ("PGAE", "PGAE-BERT", "PGAE-BERT-phrasings"); signal:
 // "describe", "execute", "repeat action" or "repeat language"; episode: a test episode's id,
@@ -12,15 +12,16 @@
 // episode's words, or, for the PGAE-BERT models, any sentence. words: what the model writes
 // ("" for <EOS> alone); understood: the text said back under "repeat language" (null without
 // text); joints: (steps, 5) in the data's units, step 0 the start pose, as
-// pgae_lite.robot.playground.play returns them; gate: the GMU's z. A bad argument rejects with
-// the sentence Python gives. Each signal's inputs are built from the episode as
+// pgae_lite.robot.playground.play returns them; gate: the GMU's z; note: for free text under
+// execute, where the readback and the chosen episode disagree (PlayResult.note), else null. A bad
+// argument rejects with the sentence Python gives. Each signal's inputs are built from the episode as
 // pgae_lite.model.signals.make_batch builds them.
 //
 // Free text (a sentence that is not a description) runs the sentence encoder in the page: the
 // tokenizer (@huggingface/tokenizers, vendored in _static/tokenizers/), the transformer below its
-// top layer and the model's head, its own top layer and pooling (pgae_lite/web/sentence.py), after the variant's word lookup read from its table
-// (pgae_lite/web/word_table.py). Those files (about 46 MB a model) are fetched on the first free
-// text only. Under execute, free text the robot will not act on (a negation, two instructions, a
+// top layer and the model's head, its own top layer and pooling (pgae_lite/web/sentence.py),
+// after the variant's word lookup read from its table (pgae_lite/web/word_table.py). Those files
+// are fetched on the first free text only (their bytes: results/live_playground.json). Under execute, free text the robot will not act on (a negation, two instructions, a
 // cube that is not there: pgae_lite/robot/refusals.py) rejects with Python's sentence
 // (pgae-refusals.js), and the result's note says where the readback and the episode disagree.
 //
@@ -323,22 +324,8 @@
     return out;
   }
 
-  // NICO's fingertip and arm at joint angles q (radians), by forward kinematics of the simulator's arm
-  // (pgae_lite.sim.robot.nico_urdf: shoulder z, shoulder -y, arm x, elbow -y, wrist -y): the shoulder,
-  // elbow, wrist and fingertip, each [x, y, z] in metres (NICO's frame, which is the world's).
-  function fk(q) {
-    const a = manifest.arm, mul = (A, B) => A.map(r => [0, 1, 2].map(j => r[0] * B[0][j] + r[1] * B[1][j] + r[2] * B[2][j]));
-    const rz = t => [[Math.cos(t), -Math.sin(t), 0], [Math.sin(t), Math.cos(t), 0], [0, 0, 1]];
-    const ry = t => [[Math.cos(t), 0, Math.sin(t)], [0, 1, 0], [-Math.sin(t), 0, Math.cos(t)]];
-    const rx = t => [[1, 0, 0], [0, Math.cos(t), -Math.sin(t)], [0, Math.sin(t), Math.cos(t)]];
-    const down = (p, R, l) => p.map((v, i) => v - R[i][2] * l);           // p + R (0, 0, -l)
-    const R1 = mul(mul(rz(q[0]), ry(-q[1])), rx(q[2]));                  // about +z, -y, +x
-    const elbow = down(a.shoulder, R1, a.upper_arm);
-    const R2 = mul(R1, ry(-q[3]));                                       // the elbow, about -y
-    const wrist = down(elbow, R2, a.forearm);
-    const tip = down(wrist, mul(R2, ry(-q[4])), a.fingertip);            // the wrist, about -y
-    return [a.shoulder, elbow, wrist, tip];
-  }
+  // NICO's arm at joint angles q (radians): the shoulder, elbow, wrist and fingertip (pgae-arm.js).
+  const fk = (q) => window.pgaeArm.fk(manifest.arm, q);
 
   // The simulator's own closed-loop run of a model on an episode, made when the book was built, or null.
   async function simulated(model, episode) {
