@@ -20,7 +20,8 @@ tokenizer, the sentence encoder, the model's head and word table); ``seconds_to_
 ``seconds_per_free_text`` (the median over ``--runs`` further sentences); and ``parity``: every
 paraphrase, and ``--per-kind`` sentences of each kind of benchmarks/refusals.py's grammar, run in the
 page against Python (:func:`pgae_lite.web.sentence.free_text_reference` and the refusal rule): the texts
-whose refusal, words or readback differ, and the largest joint difference relative to the joint range.
+whose refusal, words or readback differ, and the largest joint difference relative to the joint range;
+then the same parity with the encoder's weights in float32 (``export-web --float32``).
 
 Writes results/live_playground.json. The budget (issue 47): the closed-vocabulary playground
 answers within 3 s of opening the page and adds at most 20 MB; free text at most 50 MB more, loaded
@@ -213,9 +214,19 @@ def main() -> None:
                     for name, m in manifest["models"].items() if m["reads"] == "features"]
             browser.close()
         server.shutdown()
+        # the same parity with the sentence encoder's weights in float32 (export-web --float32): what float16 costs
+        shutil.rmtree(site_dir / "_static" / "web")
+        full = export_web(site_dir / "_static" / "web", args.profile, args.seeds[0], simulate=False, half=False)
+        site, server = serve(site_dir)
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            free32 = [parity(site, browser, name, full, args.per_kind)
+                      for name, m in full["models"].items() if m["reads"] == "features"]
+            browser.close()
+        server.shutdown()
     for m in models:
         print(m, flush=True)
-    for m in free:
+    for m in free + free32:
         print(m, flush=True)
     print("chapter 05's box, both models:", box, flush=True)
     vendored = {json.loads((ROOT / "book" / "_vendor" / d / "package.json").read_text())["name"]:
@@ -224,6 +235,7 @@ def main() -> None:
     within = (all(m["seconds_to_first_result"] <= 3.0 and m["live_bytes"] <= 20e6
                   and m.get("free_text_bytes", 0) <= 50e6 for m in models) and box["free_text_bytes"] <= 50e6)
     bench.write({"models": models, "free_text_parity": free, "chapter05_box_both_models": box, "files": files,
+                 "free_text_parity_float32": free32, "free_text_megabytes_float32": full["free_text"]["bytes"] / 1e6,
                  "episodes": len(manifest["episodes"]), "transformer_weights": "float16", "vendored": vendored,
                  "budget": {"seconds_to_first_result": 3.0, "live_megabytes": 20.0, "free_text_megabytes": 50.0},
                  "within_budget": within})

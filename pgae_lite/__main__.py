@@ -95,6 +95,9 @@ def main(argv: list[str] | None = None) -> int:
     web.add_argument("--profile", choices=PROFILE_NAMES, default=None,
                      help=f"the models' profile (default: ${PROFILE_ENV}, else 'book')")
     web.add_argument("--no-simulator", action="store_true", help="without the simulator's runs")
+    web.add_argument("--float32", action="store_true",
+                     help="the sentence encoder's weights in float32: the page then reads free text exactly as "
+                          "Python does, to float32 rounding, but fetches about twice the bytes (float16 by default)")
     web.add_argument("--no-progress", action="store_true", help="no progress bar")
     args = parser.parse_args(argv)
     from pgae_lite.util.errors import ArgumentError, PGAELiteError
@@ -126,7 +129,8 @@ def run_command(args: argparse.Namespace) -> int:
     if args.command == "export-web":
         from pgae_lite.web.assets import export_web
 
-        manifest = export_web(args.out, profile, progress=not args.no_progress, simulate=not args.no_simulator)
+        manifest = export_web(args.out, profile, progress=not args.no_progress, simulate=not args.no_simulator,
+                              half=not args.float32)
         print(f"live playground: {len(manifest['models'])} models and {len(manifest['episodes'])} test episodes "
               f"({manifest['profile']} profile) in {args.out}")
         return 0

@@ -208,9 +208,10 @@ def test_export_web_writes_what_the_books_build_writes(smoke_episodes, tmp_path,
     pytest.importorskip("onnxruntime")
     monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
     out = tmp_path / "web"
-    assert main(["export-web", str(out), "--no-simulator", "--no-progress"]) == 0
+    assert main(["export-web", str(out), "--no-simulator", "--no-progress", "--float32"]) == 0
     assert capsys.readouterr().out.startswith("live playground: 3 models and ")
     manifest = json.loads((out / "manifest.json").read_text())
     assert manifest["profile"] == "smoke" and manifest["sim_runs"] is None and not (out / "sim_runs.json").exists()
+    assert manifest["free_text"]["weights"] == "float32" and manifest["free_text"]["bytes"] > 80e6
     for entry in manifest["models"].values():
         assert (out / entry["file"]).stat().st_size == entry["bytes"]

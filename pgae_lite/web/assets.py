@@ -79,9 +79,10 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.nda
 
 
 def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False,
-               simulate: bool = True) -> dict:
+               simulate: bool = True, half: bool = True) -> dict:
     """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
-    ``simulate=False``: without the simulator's runs (the page then keeps the cubes where they lay)."""
+    ``simulate=False``: without the simulator's runs (the page then keeps the cubes where they lay);
+    ``half=False``: the sentence encoder's weights in float32 (:func:`~pgae_lite.web.free_text.export_free_text`)."""
     out = make_folder(out)
     make_folder(out / "models")
     prof = get_profile(profile)
@@ -107,7 +108,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
             entry |= {"table": f"models/{name}.table", "features": int(table.shape[1])}
             encoders[name] = model.language_encoder
         models[name] = entry
-    free_text = export_free_text(out, encoders, models) if encoders else None
+    free_text = export_free_text(out, encoders, models, half) if encoders else None
     values, episodes = _episodes(data.split("test"), normaliser, prof.data)
     with atomic_write(out / "episodes.bin") as f:
         f.write(values.tobytes())

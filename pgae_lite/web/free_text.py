@@ -48,19 +48,21 @@ def _tokenizer(tokenizer, folder: Path) -> None:
     atomic_write_text(folder / "tokenizer_config.json", _compact(config))
 
 
-def export_free_text(out: Path, encoders: dict, entries: dict) -> dict:
+def export_free_text(out: Path, encoders: dict, entries: dict, half: bool = True) -> dict:
     """Write the files above for the PGAE-BERT models ``encoders`` (name -> language encoder); add each
-    model's files to its ``entries[name]``; return what the manifest says of the shared ones."""
+    model's files to its ``entries[name]``; return what the manifest says of the shared ones.
+    ``half=False``: the weights in float32 (twice the bytes, past the page's 50 MB budget; the page then
+    computes what Python computes to float32 rounding, where float16 weights can tip a near tie)."""
     names = {encoder.name for encoder in encoders.values()}
     if len(names) != 1:
         raise ValueError(f"the page holds one sentence encoder, but the models read {sorted(names)}")
     encoder = next(iter(encoders.values()))
-    transformer_onnx(encoder.transformer.model, out / "models" / "transformer.onnx")
+    transformer_onnx(encoder.transformer.model, out / "models" / "transformer.onnx", half=half)
     _tokenizer(encoder.transformer.tokenizer, out / "tokenizer")
     shared = shared_words()
     atomic_write_text(out / "refusals.json", _compact(shared))
     for name, encoder in encoders.items():
-        head_onnx(encoder, out / "models" / f"{name}.head.onnx")
+        head_onnx(encoder, out / "models" / f"{name}.head.onnx", half=half)
         atomic_write_text(out / "models" / f"{name}.refusals.json", _compact(model_reading(encoder, shared)))
         entries[name] |= {"head": f"models/{name}.head.onnx", "words": None,
                           "refusals": f"models/{name}.refusals.json",
@@ -74,7 +76,7 @@ def export_free_text(out: Path, encoders: dict, entries: dict) -> dict:
     files += [entry[k] for entry in entries.values() for k in ("head", "words", "refusals") if entry.get(k)]
     return {"transformer": files[0], "refusals": files[1], "tokenizer": files[2], "vocab": files[3],
             "tokenizer_config": files[4], "max_tokens": int(min(encoder.transformer.tokenizer.model_max_length, 512)),
-            "bytes": sum((out / f).stat().st_size for f in files)}
+            "bytes": sum((out / f).stat().st_size for f in files), "weights": "float16" if half else "float32"}
 
 
 __all__ = ["export_free_text"]
