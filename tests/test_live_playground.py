@@ -205,6 +205,8 @@ def test_the_widget_runs_in_the_page(page):
     result = json.loads(widget.get_attribute("data-result"))
     assert len(result["joints"]) == MANIFEST["episodes"][0]["steps"] and len(result["gate"]) > 0
     assert "computed in this page" in widget.locator("pre").inner_text()
+    # the arm at the episode's last step (the animation stopped there), as a reader sees it after Play
+    widget.locator("input.pgae-live-time").evaluate("s => { s.value = s.max; s.dispatchEvent(new Event('input')); }")
     Path(ROOT / "_build" / "screenshots").mkdir(parents=True, exist_ok=True)
     widget.screenshot(path=str(ROOT / "_build" / "screenshots" / "live_playground.png"))
     assert not errors, errors
