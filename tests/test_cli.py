@@ -215,3 +215,9 @@ def test_export_web_writes_what_the_books_build_writes(smoke_episodes, tmp_path,
     assert manifest["free_text"]["weights"] == "float32" and manifest["free_text"]["bytes"] > 80e6
     for entry in manifest["models"].values():
         assert (out / entry["file"]).stat().st_size == entry["bytes"]
+    from matplotlib.image import imread
+
+    for episode in manifest["episodes"]:                          # NICO's recorded camera, first and last step
+        for which in ("first", "last"):
+            name = manifest["frames"].format(episode=episode["id"].removeprefix("sim/"), which=which)
+            assert imread(out / name).shape[:2] == (120, 160)

@@ -205,6 +205,9 @@ def test_the_widget_runs_in_the_page(page):
     result = json.loads(widget.get_attribute("data-result"))
     assert len(result["joints"]) == MANIFEST["episodes"][0]["steps"] and len(result["gate"]) > 0
     assert "computed in this page" in widget.locator("pre").inner_text()
+    shown = widget.locator(".pgae-live-camera img")              # NICO's recorded camera, loaded
+    assert shown.count() == 2 and all(shown.nth(k).evaluate("i => i.complete && i.naturalWidth") == 160
+                                      for k in range(2))
     # the arm at the episode's last step (the animation stopped there), as a reader sees it after Play
     widget.locator("input.pgae-live-time").evaluate("s => { s.value = s.max; s.dispatchEvent(new Event('input')); }")
     Path(ROOT / "_build" / "screenshots").mkdir(parents=True, exist_ok=True)

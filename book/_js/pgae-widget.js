@@ -173,6 +173,7 @@
                                    placeholder: "or type a description, e.g. push red slowly"});
     const button = element("button", {type: "button", class: "pgae-live-run", text: "Run"});
     const said = element("pre", {class: "pgae-live-said"});
+    const camera = element("div", {class: "pgae-live-camera"});
     // The animation's controls are <input>s, not <button>s: the Run button stays the widget's only <button>.
     const play = element("input", {type: "button", class: "pgae-live-play", value: "Play", disabled: ""});
     const slider = element("input", {type: "range", class: "pgae-live-time", min: "0", max: "0", value: "0",
@@ -186,10 +187,23 @@
     const joints = element("canvas", {width: "640", height: "260"});
     const gate = element("canvas", {width: "640", height: "120"});
     root.textContent = "";
-    [model, signal, episode, text, button, said, arm,
+    [model, signal, episode, text, button, camera, said, arm,
      element("div", {}, play, " ", slider, " ", clock, " ", simToggle), note, joints, gate].forEach(c => root.appendChild(c));
     arm.style.cursor = "grab"; arm.style.touchAction = "none"; arm.style.maxWidth = "100%";
     slider.style.width = "240px"; note.style.fontSize = "0.9em";
+
+    // NICO's camera in the chosen episode's recording (the build's PNGs), first and last step.
+    function showCamera() {
+      camera.textContent = "";
+      if (!window.pgae.frame(episode.value, "first")) return;
+      ["first", "last"].forEach(which => camera.appendChild(element("img", {
+        src: window.pgae.frame(episode.value, which), width: "160", height: "120",
+        alt: `NICO's camera at the ${which} step of ${episode.value}`, style: "margin-right: 4px"})));
+      camera.appendChild(element("div", {style: "font-size: 0.85em",
+        text: "NICO's camera in this episode's recording, first and last step (what the CAE read, not this page)"}));
+    }
+    episode.addEventListener("change", showCamera);
+    showCamera();
 
     // What is drawn: s (the run, its target, the episode, the simulator's run or null) at step t.
     const view = {...VIEW};

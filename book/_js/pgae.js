@@ -26,6 +26,7 @@
 // (pgae-refusals.js), and the result's note says where the readback and the episode disagree.
 //
 //   window.pgae.readAs(model, text) -> Promise of the text as the model reads it (the variant's lookup).
+//   window.pgae.frame(episode, "first" | "last") -> the URL of NICO's recorded camera frame, or null.
 //   window.pgae.simulated(model, episode) -> Promise of null or the simulator's own closed-loop run
 //   of that model on that episode, made when the book was built (pgae_lite/web/sim_runs.py).
 (function () {
@@ -336,7 +337,11 @@
     return r ? {label: all.label, ...r} : null;
   }
 
-  window.pgae = {run, load, recorded, fk, simulated, readAs, manifest: () => manifest};
+  // The URL of NICO's recorded camera frame of an episode ("first" or "last" step), or null.
+  const frame = (episode, which) => (manifest.frames ? new URL(`web/${manifest.frames.replace(
+    "{episode}", String(episode).replace(/^sim\//, "")).replace("{which}", which)}`, BASE).href : null);
+
+  window.pgae = {run, load, recorded, fk, simulated, readAs, frame, manifest: () => manifest};
   document.addEventListener("DOMContentLoaded", () => {
     document.querySelectorAll(".pgae-live").forEach(el => window.pgaeWidget && window.pgaeWidget(el));
   });

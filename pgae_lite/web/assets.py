@@ -9,6 +9,9 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
                           row ``manifest["fixed_rows"]["s,w1,w2,w3,eos"]`` for those tokens
     (free text)           PGAE-BERT's sentence encoder, word table and refusals (free_text.py)
     sim_runs.json         the simulator's closed-loop runs at build time (sim_runs.py), labelled so
+    frames/PPP-V-first.png, frames/PPP-V-last.png
+                          NICO's camera in each test episode's recording, at its first and last step
+                          (what the CAE read; the page shows them for the chosen episode)
     episodes.bin          every test episode, normalised as the model reads it, float32:
                           action input (T, 35): [v_t; j_t] per step
     manifest.json         the vocabulary, signals, models, the episodes' index (with where each
@@ -78,6 +81,24 @@ def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.nda
     return np.concatenate(chunks), index
 
 
+def _frames(out: Path, test: PGAEDataset, config) -> str:
+    """NICO's recorded camera frames at the first and last step of every test episode, as PNG files; the
+    pattern of their names in ``out`` (``{episode}``: an id without ``sim/``; ``{which}``: first or last)."""
+    from matplotlib.image import imsave
+
+    from pgae_lite.data.simulated import load_episode
+
+    make_folder(out / "frames")
+    for sample, steps in zip(map(str, test.ids), test.lengths.tolist()):
+        name = sample.removeprefix("sim/")                                  # "PPP-V"
+        pattern, variation = map(int, name.split("-"))
+        images = load_episode(config, pattern, variation).images          # (T, 120, 160, 3) uint8
+        for which, frame in (("first", images[0]), ("last", images[int(steps) - 1])):
+            with atomic_write(out / "frames" / f"{name}-{which}.png") as f:
+                imsave(f, frame, format="png")
+    return "frames/{episode}-{which}.png"
+
+
 def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False,
                simulate: bool = True, half: bool = True) -> dict:
     """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
@@ -110,6 +131,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         models[name] = entry
     free_text = export_free_text(out, encoders, models, half) if encoders else None
     values, episodes = _episodes(data.split("test"), normaliser, prof.data)
+    frames = _frames(out, data.split("test"), prof.data)
     with atomic_write(out / "episodes.bin") as f:
         f.write(values.tobytes())
     manifest = {
@@ -122,7 +144,7 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
         "fixed_texts": {tokens_to_text(row): r for r, row in enumerate(rows)}, "free_text": free_text,
         "arm": _arm(), "cube_rgba": {c: list(v) for c, v in CUBE_RGBA.items()},
-        "sim_runs": "sim_runs.json" if simulate else None,
+        "sim_runs": "sim_runs.json" if simulate else None, "frames": frames,
     }
     if simulate:
         simulator_runs(out, MODELS, prof.name, seed, progress=progress)
