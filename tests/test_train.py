@@ -125,6 +125,14 @@ def test_finished_run_returns_at_once(toy_short, tmp_path):
     assert _same_weights(_weights(again.model), _weights(first.model))
 
 
+def test_the_progress_bar_names_its_model_and_a_finished_model_shows_none(toy_short, tmp_path, capsys):
+    prof = tiny_profile(epochs=2)
+    train(toy_short, prof, out_dir=tmp_path, progress=True, device="cpu", name="PGAE-BERT")
+    assert "PGAE-BERT (" in capsys.readouterr().err                  # the bar of the training, named
+    train(toy_short, prof, out_dir=tmp_path, progress=True, device="cpu", name="PGAE-BERT")
+    assert "PGAE-BERT (" not in capsys.readouterr().err              # loaded from the cache: no bar
+
+
 def test_resume_after_interruption_is_identical(toy_short, tmp_path, interrupt_training):
     """Stopping at epoch 3 of 5 (no checkpoint for it) and training again gives the same run."""
     prof = tiny_profile(epochs=5)

@@ -167,7 +167,7 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
     announced = False
     while True:
         try:
-            return train(dataset, prof, out_dir=folder, device=device, progress=progress)
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=training.name)
         # Damaged, or saved with other data statistics (the folder's name fixes the data and CAE, so an
         # older pgae_lite scaled them otherwise): trained again, like the CAE.
         except (CorruptCheckpointError, DataMismatchError) as e:

@@ -83,7 +83,7 @@ def batch_indices(lengths: torch.Tensor, batch_size: int, generator: torch.Gener
 
 def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
           device: torch.device | str | None = None, progress: bool = True,
-          model: PGAE | None = None, callback=None) -> Trained:
+          model: PGAE | None = None, callback=None, name: str = "PGAE") -> Trained:
     """Train PGAE on the training split of ``dataset`` with ``profile``'s recipe.
 
     ``profile``: a :class:`~pgae_lite.config.Profile` (``pgae_lite.config.get_profile(name)``).
@@ -94,12 +94,13 @@ def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
     second run there fail (:class:`~pgae_lite.util.storage.FolderBusyError`).
     ``callback(epoch, model, record)``, if given, is called after every epoch
     (e.g. to evaluate along the way). A NaN or infinite loss stops the run
-    (:class:`NonFiniteLossError`, naming the epoch and the batch).
+    (:class:`NonFiniteLossError`, naming the epoch and the batch). ``name``: the model's, on the progress
+    bar, which shows only while there are epochs to train (a finished model loaded from ``out_dir`` shows none).
     """
     if not hasattr(profile, "to_dict") or not hasattr(profile, "train"):
         raise TypeError(f"train takes a Profile, e.g. pgae_lite.config.get_profile('book'); got {profile!r}")
     device = torch.device(device) if device else default_device()
-    args = (dataset, profile, out_dir, device, progress, model, callback)
+    args = (dataset, profile, out_dir, device, progress, model, callback, name)
     with training_threads(device):   # on the CPU a fixed thread count: the same model on any machine
         if out_dir is None:
             return _train(*args)
@@ -108,7 +109,7 @@ def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
 
 
 def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: torch.device,
-           progress: bool, model: PGAE | None, callback) -> Trained:
+           progress: bool, model: PGAE | None, callback, name: str) -> Trained:
     cfg = profile.train
     cfg.__post_init__()              # checked again: a field may have been set since
     train_set = training_split(dataset, cfg.max_train_samples)
@@ -120,8 +121,8 @@ def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: to
     weights = word_weights(getattr(run.model, "lexicon", None)).to(device)   # the model's words
     t0 = time.perf_counter() - run.elapsed
     bank = for_training(run.model.language_encoder, cfg)    # its encoding time counts as training time
-    bar = tqdm(range(run.epoch, cfg.epochs), desc=f"PGAE ({profile.name})", disable=not progress,
-               initial=run.epoch, total=cfg.epochs)
+    bar = tqdm(range(run.epoch, cfg.epochs), desc=f"{name} ({profile.name})", initial=run.epoch, total=cfg.epochs,
+               disable=not progress or run.epoch >= cfg.epochs)          # nothing to train: no bar
     for epoch in bar:
         record = _epoch(run, cfg, epoch, weights, bank, device)
         bar.set_postfix(loss=f"{record['loss']:.4f}", lang=f"{record['language_loss']:.4f}",
