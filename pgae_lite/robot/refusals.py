@@ -78,10 +78,16 @@ def _reading(encoder, text: str) -> tuple[WordLookup, str, dict[str, str]]:
     return own, own.rewrite(text), own.replacements(text)
 
 
+@lru_cache(maxsize=1)
+def _colour_kinds() -> frozenset:
+    """WordNet's colour sense and every sense below it (its hyponyms, all the way down)."""
+    colour = wordnet().synset("color.n.01")
+    return frozenset({colour, *colour.closure(lambda x: x.hyponyms())})
+
+
 def is_colour_word(word: str) -> bool:
     """Whether WordNet lists ``word`` as a kind of colour (``black``, ``orange``), by any sense."""
-    colour = wordnet().synset("color.n.01")
-    return any(s == colour or colour in s.closure(lambda x: x.hypernyms()) for s in wordnet().synsets(word))
+    return any(s in _colour_kinds() for s in wordnet().synsets(word))
 
 
 def _negated(read: str, lexicon: PhraseLexicon) -> tuple[list[str], list[str]]:

@@ -22,7 +22,7 @@ import tempfile
 from pathlib import Path
 
 from pgae_lite.util.storage import atomic_write_text, make_folder
-from pgae_lite.web.refusal_data import model_reading, shared_words
+from pgae_lite.web.refusal_data import front_coded, model_reading, shared_words
 from pgae_lite.web.sentence import head_onnx, transformer_onnx
 from pgae_lite.web.word_table import word_table
 
@@ -60,7 +60,7 @@ def export_free_text(out: Path, encoders: dict, entries: dict, half: bool = True
     transformer_onnx(encoder.transformer.model, out / "models" / "transformer.onnx", half=half)
     _tokenizer(encoder.transformer.tokenizer, out / "tokenizer")
     shared = shared_words()
-    atomic_write_text(out / "refusals.json", _compact(shared))
+    atomic_write_text(out / "refusals.json", _compact(shared | {"verbs": front_coded(shared["verbs"])}))
     for name, encoder in encoders.items():
         head_onnx(encoder, out / "models" / f"{name}.head.onnx", half=half)
         atomic_write_text(out / "models" / f"{name}.refusals.json", _compact(model_reading(encoder, shared)))

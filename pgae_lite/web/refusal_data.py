@@ -44,16 +44,15 @@ def front_coded(words: list[str]) -> str:
 
 
 def shared_words() -> dict:
-    """What every model's refusal reads: the rule's words and patterns, WordNet's colour words and verbs."""
+    """What every model's refusal reads: the rule's words and patterns, WordNet's colour words and verbs
+    (a sorted list here; :func:`front_coded` when written)."""
     dictionary = wordnet()
-    colour = dictionary.synset("color.n.01")
-    kinds = {colour} | set(colour.closure(lambda s: s.hyponyms()))     # every kind of colour
     words = candidates(shortest=1)                                    # a verb may be short: "go"
     return {"negators": sorted(refusals.NEGATORS), "sequencers": sorted(refusals.SEQUENCERS),
             "clause_end": refusals._CLAUSE_END.pattern, "step_end": refusals._STEP_END.pattern,
             "colours": list(COLOURS), "actions_said": refusals.ACTIONS_SAID,
-            "colour_words": sorted(w for w in words if len(w) >= 3 and any(s in kinds for s in dictionary.synsets(w))),
-            "verbs": front_coded([w for w in words if dictionary.synsets(w, pos="v")])}
+            "colour_words": [w for w in words if len(w) >= 3 and refusals.is_colour_word(w)],
+            "verbs": [w for w in words if dictionary.synsets(w, pos="v")]}
 
 
 def _table(lexicon) -> list:
@@ -65,13 +64,8 @@ def model_reading(encoder, shared: dict) -> dict:
     lookup: WordLookup = refusals.lookup_of(encoder)
     lexicon = lookup.lexicon
     by_verbs = replace(lexicon, directions={a: () for a in lexicon.directions})
-    verbs = shared["verbs"].split("\n")
-    words, before = [], ""
-    for line in verbs:                                          # the front coding undone
-        before = before[:ord(line[0]) - 48] + line[1:]
-        words.append(before)
     return {"phrases": _table(lexicon), "phrases_by_verbs": _table(by_verbs),
-            "known": sorted(w for w in (*words, *shared["colour_words"]) if lookup.is_known(w))}
+            "known": sorted(w for w in (*shared["verbs"], *shared["colour_words"]) if lookup.is_known(w))}
 
 
 __all__ = ["front_coded", "model_reading", "shared_words"]

