@@ -172,7 +172,7 @@ def _check_contents(path, arrays: dict[str, np.ndarray]) -> None:
 
 
 #: How visual features can be scaled to [-1, 1] (see :meth:`Normaliser.fit`).
-VISION_SCALINGS = ("global", "whiten")
+VISION_SCALINGS = ("global", "whiten", "whiten-per-view")
 #: Whitening adds this share of the largest eigenvalue to every eigenvalue before inverting, so
 #: that directions with almost no variance are not blown up.
 WHITENING_EPS = 0.01
@@ -224,14 +224,16 @@ class Normaliser:
         """Statistics from the valid steps of ``data`` (pass the training split).
 
         ``vision_scaling``: ``"global"`` (the authors': one min and max over all visual
-        features) or ``"whiten"`` (whitened first: every direction of the 30-d feature
-        space gets about the same variance, then one min and max).
+        features, each view its own) or ``"whiten"`` (whitened first: every direction of the
+        30-d feature space gets about the same variance, then NICO's view's min and max for
+        both views); ``"whiten-per-view"`` whitens too but gives each view its own min and
+        max, as the recipe did before the one-scale fix (chapter 06's ablation).
         """
         check_vision_scaling(vision_scaling)
         data.check_finite()
         m = data.mask
         white = None
-        if vision_scaling == "whiten":
+        if vision_scaling.startswith("whiten"):
             mean, W = whitening(data.vision[m])                                   # NICO's view, (30,), (30, 30)
             white = (tuple(map(float, mean)), tuple(tuple(map(float, row)) for row in W))
 
@@ -246,7 +248,8 @@ class Normaliser:
         # Whitened, the opposite view takes NICO's view's min and max too. With a min and max of its
         # own, a few directions in which only that view varies set its scale and squeezed the opposite
         # agent's motion into half the range, and PGAE-opposite described less (A2, "Visual features").
-        opposite = vision if white else lo_hi("opposite views", data.vision_opposite)
+        one_scale = vision_scaling == "whiten"
+        opposite = vision if one_scale else lo_hi("opposite views", _whiten(data.vision_opposite, white))
         return cls(lo_hi("joints", data.joints), vision, opposite, white)
 
     def _vision(self, x: np.ndarray, key: str) -> np.ndarray:
