@@ -1,4 +1,4 @@
-"""Exploration: make h carry which cube to move, for the closed loop (results page A2, "The closed loop
+"""Exploration: make h carry which cube to move, for the closed loop (experiments/HISTORY.md, "The closed loop
 moves the other cube").
 
     python experiments/first_frame_pass.py [--share 0.5] [--weight 0.25] [--detach] [--episodes 72]

@@ -19,7 +19,7 @@ descriptions) keep the frozen layer's output, cached as in PGAE-BERT: the tuned
 layer learns only from, and is only used for, free text.
 
 Chosen on validation sentences with words never trained on
-(``experiments/validation_readback.py``; A2, the free-form variant's history).
+(``experiments/validation_readback.py``; experiments/HISTORY.md).
 """
 from __future__ import annotations
 

@@ -246,8 +246,8 @@ class Normaliser:
             return lo, hi
         vision = lo_hi("visual features", _whiten(data.vision, white))
         # Whitened, the opposite view takes NICO's view's min and max too. With a min and max of its
-        # own, a few directions in which only that view varies set its scale and squeezed the opposite
-        # agent's motion into half the range, and PGAE-opposite described less (A2, "Visual features").
+        # own, a few directions in which only that view varies set its scale and squeeze the opposite
+        # agent's motion into part of the range ("whiten-per-view": chapter 06 measures what it costs).
         one_scale = vision_scaling == "whiten"
         opposite = vision if one_scale else lo_hi("opposite views", _whiten(data.vision_opposite, white))
         return cls(lo_hi("joints", data.joints), vision, opposite, white)

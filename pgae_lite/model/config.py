@@ -38,7 +38,7 @@ class ModelConfig:
     joint_feedback: str = "start"
     # Deviation from paper: one step of the action LSTMs covers 3 time steps: the encoder reads every 3rd
     # step, the decoder reads every 3rd frame and writes the next 3 poses, every pose (paper: 1). A third of
-    # the LSTM steps per sample, with Table 1 kept; stride 4 lost joint precision (A2, the recipe's history).
+    # the LSTM steps per sample, with Table 1 kept; stride 4 lost joint precision (experiments/HISTORY.md).
     time_stride: int = 3
     # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (bert/pretrained.py);
     # "pretrained-attention" = the same transformer with a trained attention pooling (bert/attention_pooling.py).
@@ -50,7 +50,7 @@ class ModelConfig:
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
     # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
     # every sample early in training, and describe never learns: one sentence for every action
-    # (A2, "The describe collapse").
+    # (experiments/HISTORY.md, "The describe collapse").
     gmu_norm: bool = True
     # Deviation from paper: a plan head reads h and predicts this many keyframes of the motion in training
     # (plan.PlanHead; 0 = none, the paper's). It makes h carry which cube the words mean in this scene, which

@@ -5,4 +5,5 @@
 - ``new_colour``  the same pipeline for a world with a new colour (appendix A3)
 - ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
 - ``results``     the committed result files, read and quoted by the book and the README
+- ``departures``  the book's recipe against the paper's, each departure with its measured effect
 """

@@ -13,7 +13,7 @@ Table 1's trainings by name.
   trained on 60 phrasings of every instruction under repeat language only: it says a sentence back
   in the dataset's words and executes those (:mod:`pgae_lite.robot.instructions`, route "said
   back"), so execute reads the descriptions alone. Chosen on validation sentences
-  (``experiments/validation_readback.py``; A2, lab log), never on the test paraphrases.
+  (``experiments/validation_readback.py``; experiments/HISTORY.md), never on the test paraphrases.
 - :data:`PHRASINGS_HELD_OUT`: the same with some words never trained on
   (:func:`pgae_lite.bert.phrase_lexicon.held_out_words`): ``benchmarks/free_language.py``'s "unseen" measure.
 """

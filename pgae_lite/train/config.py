@@ -57,7 +57,7 @@ class TrainConfig:
     clip: float | None = 1.0            # gradient-norm clipping (paper: none)
     # Deviation from paper: decoupled weight decay (AdamW; paper: Adam, none). Smaller weights favour one
     # rule shared by all actions ("say the moved cube's colour") over a table of action-specific ones
-    # (A2, lab log: "weight decay 0.1").
+    # (experiments/HISTORY.md: "weight decay 0.1").
     weight_decay: float = 0.1
     # Deviation from paper: a signal per sample (authors: one per batch).
     signals_per_sample: bool = True
@@ -69,13 +69,13 @@ class TrainConfig:
     teacher_language: bool = True
     # Deviation from paper: Gaussian noise of this std on the action encoder's inputs (vision and
     # joints, in model units [-1, 1]) in training: 0.1 on the visual features, 0.05 on the joints
-    # (A2, lab log: "input noise").
+    # (experiments/HISTORY.md: "input noise").
     input_noise: float = 0.1
     joint_input_noise: float | None = 0.05   # std on the joints part only; None: input_noise
     opposite_prob: float = 0.0          # chance that a sample shows the opposite agent's view
     # Deviation from paper: the visual features are whitened before the min/max scaling ("whiten",
     # see data.dataset.Normaliser; authors: "global", one min and max over all 30 features)
-    # (A2, lab log: "whitening").
+    # (experiments/HISTORY.md: "whitening").
     vision_scaling: str = "whiten"
     language_weight: float = 1.0        # α
     # Deviation from paper: β = 4 (paper: 1). A 0.5% joint error is a loss of about 1e-4, the words' ~0.1.
@@ -88,7 +88,7 @@ class TrainConfig:
     # descriptions.
     phrasings: int = 0
     # Chosen on generated validation sentences (experiments/validation_readback.py), never on the test
-    # paraphrases (A2, lab log).
+    # paraphrases (experiments/HISTORY.md).
     phrasing_prob: float = 0.75
     # "all": the phrasings use the whole lexicon; "held-out": less phrase_lexicon.held_out_words(), so
     # that a test sentence with one of those words says something never trained on.
