@@ -12,12 +12,16 @@ with three scalings of the visual features, on each dataset, once per seed:
   the recipe did before the one-scale fix;
 - ``global``: the authors' code's scaling, no whitening, each view its own minimum and maximum.
 
+With ``--curve 10 20 40 ...`` it instead trains the recipe's two-view model once per seed and
+dataset, afresh, and describes the test split from both views at those epochs of the training:
+how the gap between the views closes as the model learns (results/opposite_scale-curve.json).
+
 Each model is evaluated on the test split on both views (PGAE-self and PGAE-opposite);
 beside the cells, how much of [-1, 1] the other agent's motion covers after scaling
-(``opposite_spread``: the std of the opposite view's features over the valid training steps,
-divided by that of NICO's view, averaged over the 30 features). Our data's models are cached
+(``opposite_spread``, :func:`pgae_lite.runs.opposite_scale.spread_of`). Our data's models are cached
 as every training is; the authors' data's runs resume under benchmarks/out/. Writes
-results/opposite_scale.json.
+results/opposite_scale-ours.json or opposite_scale-original.json (one dataset asked for),
+else results/opposite_scale.json.
 """
 from __future__ import annotations
 
@@ -27,9 +31,10 @@ import torch
 
 from harness import Benchmark, side_by_side
 from pgae_lite.config import TRAININGS, Training, get_profile, training_profile
-from pgae_lite.data.dataset import Normaliser
 from pgae_lite.data.original import load_original
-from pgae_lite.evaluate import evaluate
+from pgae_lite.data.dataset import Normaliser
+from pgae_lite.evaluate import evaluate, predict
+from pgae_lite.runs.opposite_scale import spread_of
 from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.train.loop import train
 
@@ -41,15 +46,6 @@ def views_with(scaling: str) -> Training:
     if scaling == "whiten":
         return VIEWS
     return Training(f"PGAE-views-{scaling}", train={**VIEWS.train, "vision_scaling": scaling})
-
-
-def spread(data, scaling: str) -> float:
-    """The opposite view's std after scaling over NICO's view's, feature by feature, averaged."""
-    train_set = data.split("train")
-    t = Normaliser.fit(train_set, scaling).tensors(train_set)
-    valid = torch.from_numpy(train_set.mask)
-    mine, theirs = t["vision"][valid].std(0), t["vision_opposite"][valid].std(0)      # (30,) each
-    return float((theirs / mine).mean())
 
 
 def run(source: str, scaling: str, seed: int, profile_name: str, path: str) -> dict:
@@ -68,10 +64,30 @@ def run(source: str, scaling: str, seed: int, profile_name: str, path: str) -> d
         result, _ = evaluate(trained.model, data, trained.normaliser, opposite=opposite)
         cells[view] = {s: {k: round(v, 4) for k, v in c.items()} for s, c in result.items()}
     row = {"data": source, "scaling": scaling, "seed": seed, "train_seconds": round(trained.seconds, 1),
-           "opposite_spread": round(spread(data, scaling), 4), "table1": cells}
+           "opposite_spread": round(spread_of(data, scaling), 4), "table1": cells}
     print({k: v for k, v in row.items() if k != "table1"},
           {v: cells[v]["describe"]["accuracy"] for v in cells}, flush=True)
     return row
+
+
+def curve(source: str, seed: int, profile_name: str, path: str, epochs: list[int]) -> dict:
+    """One training of the recipe's two-view model; describe on both views at ``epochs``."""
+    torch.set_num_threads(1)
+    data = simulated_dataset(profile_name, "cpu", progress=False) if source == "ours" else load_original(path)
+    profile = training_profile(get_profile(profile_name, seed=seed), VIEWS)
+    normaliser = Normaliser.fit(data.split("train"), profile.train.vision_scaling)   # the training's own
+    test = data.split("test")
+    points = []
+
+    def describe(epoch: int, model, record: dict) -> None:
+        if epoch in epochs:
+            points.append({"epoch": epoch, **{view: round(100 * float(predict(
+                model, test, normaliser, "describe", opposite=opposite).correct.mean()), 2)
+                for view, opposite in (("self", False), ("opposite", True))}})
+
+    train(data, profile, progress=False, callback=describe)
+    print(source, seed, points, flush=True)
+    return {"data": source, "seed": seed, "points": points}
 
 
 def main() -> None:
@@ -80,7 +96,19 @@ def main() -> None:
     bench.add_workers(2, "trainings")
     bench.parser.add_argument("--data", nargs="+", default=["ours", "original"], choices=["ours", "original"])
     bench.parser.add_argument("--scalings", nargs="+", default=["whiten", "whiten-per-view", "global"])
+    bench.parser.add_argument("--curve", type=int, nargs="+", metavar="EPOCH",
+                              help="describe on both views at these epochs of one training per seed")
     args = bench.parse()
+    if args.curve:
+        bench.name = "opposite_scale-curve"
+        if "ours" in args.data:
+            simulated_dataset(args.profile, "cpu", progress=False)
+        jobs = [(source, seed, args.profile, args.original_data, args.curve)
+                for source in args.data for seed in args.seeds]
+        return bench.write({"training": VIEWS.name, "epochs": args.curve,
+                            "runs": side_by_side(curve, jobs, args.workers)})
+    if len(args.data) == 1:
+        bench.name = f"opposite_scale-{args.data[0]}"
     if "ours" in args.data:
         simulated_dataset(args.profile, "cpu", progress=False)       # recorded once, before the workers start
     jobs = [(source, scaling, seed, args.profile, args.original_data)

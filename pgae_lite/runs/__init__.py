@@ -6,4 +6,5 @@
 - ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
 - ``results``     the committed result files, read and quoted by the book and the README
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect
+- ``opposite_scale`` chapter 06's ablation: the two-view model under three scalings
 """

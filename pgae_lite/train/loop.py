@@ -125,8 +125,8 @@ def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: to
                disable=not progress or run.epoch >= cfg.epochs)          # nothing to train: no bar
     for epoch in bar:
         record = _epoch(run, cfg, epoch, weights, bank, device)
-        bar.set_postfix(loss=f"{record['loss']:.4f}", lang=f"{record['language_loss']:.4f}",
-                        act=f"{record['action_loss']:.5f}")
+        bar.set_postfix_str(f"loss {record['loss']:.4f} (words {record['language_loss']:.4f}, "
+                            f"joints {record['action_loss']:.5f})")
         if callback is not None:
             callback(epoch + 1, run.model, record)
             run.model.train()
