@@ -11,6 +11,8 @@ for Python, with the system browser: no ``playwright install``):
 - every formula is typeset by MathJax (no raw TeX left, no MathJax errors);
 - no executed cell shows an error (traceback or ``Traceback`` on stderr);
 - saved widgets and matplotlib animations are drawn;
+- no code line runs past its block, hidden behind a sideways scroll (long lines
+  wrap: book/_css/pgae.css), at 1280 px and at a phone's 400 px;
 - every link to a page of the book (navigation, sidebar, prev/next, text)
   answers HTTP 200;
 - with no repository address, no launch, repository or issues button; every
@@ -223,3 +225,59 @@ def test_page_renders_offline(docname, site, browser):
     }
     problems = {k: v for k, v in found.items() if v}
     assert not problems, f"{docname}: " + json.dumps(problems, indent=1)
+
+
+# Run in the page: every code block (a cell's input, a printed output, a code block in the text)
+# whose lines run past its width, so that their ends hide behind a sideways scroll. For each such
+# block, the lines wider than the block (measured unwrapped, in the block's own font).
+CUT_CODE = r"""async () => {
+  await document.fonts.ready;
+  const article = document.querySelector("article.bd-article") || document.body;
+  const cut = [];
+  for (const pre of new Set(article.querySelectorAll("div.cell_input pre, div.highlight pre"))) {
+    if (pre.scrollWidth <= pre.clientWidth + 1) continue;
+    const style = getComputedStyle(pre);
+    const room = pre.clientWidth - parseFloat(style.paddingLeft) - parseFloat(style.paddingRight);
+    const lines = pre.textContent.replace(/\n$/, "").split("\n");
+    const probe = pre.appendChild(document.createElement("span"));
+    probe.style.cssText = "white-space: pre; position: absolute; visibility: hidden;";
+    const wide = lines.filter(line => {
+      probe.textContent = line;
+      return probe.getBoundingClientRect().width > room + 1;
+    });
+    probe.remove();
+    cut.push({scrollWidth: pre.scrollWidth, clientWidth: pre.clientWidth,
+              lines: (wide.length ? wide : lines).map(line => line.slice(0, 80))});
+  }
+  return cut;
+}"""
+
+
+@pytest.mark.parametrize("width", [1280, 400], ids=["desktop", "narrow"])
+@pytest.mark.parametrize("docname", PAGES)
+def test_code_lines_not_cut_off(docname, width, site, browser):
+    """No code line runs past its block: long lines wrap (book/_css/pgae.css), at the other
+    tests' viewport and at a phone's width."""
+    context = browser.new_context(viewport={"width": width, "height": 900})
+    context.route("**/*", lambda route: route.continue_() if route.request.url.startswith(site) else route.abort())
+    page = context.new_page()
+    response = page.goto(f"{site}/{docname}.html", wait_until="load")
+    assert response is not None and response.status == 200, f"{docname}.html: {response and response.status}"
+    cut = page.evaluate(CUT_CODE)
+    context.close()
+    lines = [line for block in cut for line in block["lines"]]
+    assert not cut, (f"{docname} at {width} px: {len(lines)} code lines in {len(cut)} blocks run past "
+                     f"the block and are cut off:\n" + "\n".join(lines))
+
+
+EMPTY_OUTPUT = re.compile(r"Empty DataFrame|<tbody>\s*</tbody>|^\s*\w[\w ]*:? \{\}\s*$", re.M)
+
+
+@pytest.mark.parametrize("docname", PAGES)
+def test_no_empty_tables(docname):
+    """No output shows an empty table where a lesson asks the reader to compare it: no empty
+    DataFrame, no table without rows, no printed empty mapping (``describe {}``)."""
+    html = (BOOK / f"{docname}.html").read_text(encoding="utf-8")
+    outputs = re.findall(r'<div class="cell_output[^"]*">(.*?)</div>\s*</div>\s*</div>', html, re.S)
+    empty = [EMPTY_OUTPUT.search(o).group(0).strip() for o in outputs if EMPTY_OUTPUT.search(o)]
+    assert not empty, f"{docname}: {len(empty)} empty outputs: {empty[:5]}"

@@ -34,8 +34,12 @@ class Paraphrase:
         return self.action, self.colour, self.speed
 
 
-def load_paraphrases(path: str | Path = PARAPHRASE_FILE) -> list[Paraphrase]:
-    """The paraphrases in the file's order (lines starting with ``#`` are comments)."""
+def load_paraphrases(path: str | Path | None = None) -> list[Paraphrase]:
+    """The paraphrases in the file's order (lines starting with ``#`` are comments).
+
+    ``path``: a paraphrase file; None, the package's own (``PARAPHRASE_FILE``).
+    """
+    path = PARAPHRASE_FILE if path is None else path
     with open(path, newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader((line for line in f if not line.startswith("#")), delimiter="\t"))
     out = []

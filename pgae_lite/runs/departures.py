@@ -154,7 +154,7 @@ def _budget() -> str:
 
 
 def measured_effect(departure: Departure) -> str:
-    """What the departure did, in one sentence from its result file, or :data:`NOT_MEASURED`."""
+    """What the departure did, in one sentence from its result file, or ``NOT_MEASURED``."""
     if departure.evidence is None:
         return NOT_MEASURED
     kind, *args = departure.evidence
