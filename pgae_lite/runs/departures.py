@@ -80,11 +80,11 @@ DEPARTURES: tuple[Departure, ...] = (
               None, ("train.input_noise", "train.joint_input_noise")),
     Departure("visual features", "one minimum and maximum over all 30 (each view its own)",
               "whitened first, then one minimum and maximum",
-              "every direction of the features gets a similar spread",
-              ("scaling", "global"), ("train.vision_scaling",)),
+              "every direction of the features gets a similar spread (chapter 04 measures the spectrum)",
+              ("scaling", "global", "the authors' scaling"), ("train.vision_scaling",)),
     Departure("the opposite view's scale", "its own minimum and maximum", "NICO's view's (one scale)",
               "one picture, one set of numbers",
-              ("scaling", "whiten-per-view")),
+              ("scaling", "whiten-per-view", "each view its own scale, whitened")),
     Departure("scaling statistics", "train and test split", "training split only",
               "the test split stays unseen"),
 )
@@ -128,7 +128,7 @@ def scaling_cells(dataset: str) -> dict[str, dict[str, float]]:
     return cells
 
 
-def _scaling(scaling: str) -> str:
+def _scaling(scaling: str, label: str) -> str:
     said = []
     for dataset, called in (("original", "authors' data"), ("ours", "our data")):
         name = f"opposite_scale-{dataset}"
@@ -136,7 +136,7 @@ def _scaling(scaling: str) -> str:
         if "whiten" in cells and scaling in cells:
             book, paper = cells["whiten"], cells[scaling]
             said.append(f"{called}, {book['self']:.1f} / {book['opposite']:.1f}% with the book's, "
-                        f"{paper['self']:.1f} / {paper['opposite']:.1f}% with the paper's "
+                        f"{paper['self']:.1f} / {paper['opposite']:.1f}% with {label} "
                         f"({paper['seeds']} seeds; {name}.json)")
     if not said:
         return NOT_MEASURED
