@@ -22,7 +22,8 @@ occurs nowhere in those rows' training language. Rows 1 to 4 are measured withou
 Each of the 216 test episodes is told one of the 108 held-out paraphrases of its instruction
 (never trained on). Readback: the paraphrase under repeat language, no pictures of the action:
 is the generated description the intended one? Execution: the paraphrase under execute in the
-simulator, open loop, judged by the simulator (did the named cube move the named way?).
+simulator, open loop, judged by the simulator (did the named cube move the named way?); an
+instruction the robot refuses (:mod:`pgae_lite.robot.refusals`) is not executed and counts as not done.
 Writes results/free_form_ablation.json.
 """
 from __future__ import annotations
@@ -61,15 +62,17 @@ def measure_as_is(model, data, norm, cae, profile: str, told, unseen) -> dict:
     test = data.split("test")
     texts = [input_text("repeat language", t.text) for t in told]
     back = predict(model, test, norm, "repeat language", language=model.language_encoder.encode_texts(texts))
-    cells = {"readback_%": round(100 * back.correct.mean(), 2),
-             "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2)}
+    cells = {"readback_%": round(100 * float(back.correct.mean()), 2),
+             "readback_unseen_%": round(100 * float(back.correct[unseen].mean()), 2)}
     for route in ROUTES:
         table = execute_paraphrases(model, cae, norm, data, load_paraphrases(), closed=False, route=route,
                                     config=get_profile(profile).data, progress=False)
-        passed = table["open_passed"].to_numpy()
+        # a refused instruction is not executed: it counts as not done
+        passed = table["open_passed"].fillna(False).to_numpy(dtype=bool)
         key = route.replace(" ", "_")
-        cells[f"{key}_open_success_%"] = round(100 * passed.mean(), 2)
-        cells[f"{key}_open_success_unseen_%"] = round(100 * passed[unseen].mean(), 2)
+        cells[f"{key}_refused"] = int((table["refused"] != "").sum())
+        cells[f"{key}_open_success_%"] = round(100 * float(passed.mean()), 2)
+        cells[f"{key}_open_success_unseen_%"] = round(100 * float(passed[unseen].mean()), 2)
     return cells
 
 
