@@ -270,13 +270,14 @@ def test_code_lines_not_cut_off(docname, width, site, browser):
                      f"the block and are cut off:\n" + "\n".join(lines))
 
 
-EMPTY_OUTPUT = re.compile(r"Empty DataFrame|<tbody>\s*</tbody>|^\s*\w[\w ]*:? \{\}\s*$", re.M)
+EMPTY_OUTPUT = re.compile(r"Empty DataFrame|<tbody>\s*</tbody>|^\s*\w[\w ]*:? \{\}\s*$|<td>(?:NaN|nan|None)</td>", re.M)
 
 
 @pytest.mark.parametrize("docname", PAGES)
 def test_no_empty_tables(docname):
     """No output shows an empty table where a lesson asks the reader to compare it: no empty
-    DataFrame, no table without rows, no printed empty mapping (``describe {}``)."""
+    DataFrame, no table without rows, no printed empty mapping (``describe {}``), and no table
+    cell that reads NaN or None (a figure not measured says so in words)."""
     html = (BOOK / f"{docname}.html").read_text(encoding="utf-8")
     outputs = re.findall(r'<div class="cell_output[^"]*">(.*?)</div>\s*</div>\s*</div>', html, re.S)
     empty = [EMPTY_OUTPUT.search(o).group(0).strip() for o in outputs if EMPTY_OUTPUT.search(o)]
