@@ -40,8 +40,6 @@ import shlex
 import subprocess
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -96,6 +94,9 @@ class Benchmark:
         self.parser.add_argument("--out", default=None, help=f"result file (default: results/{name}.json)")
         self.parser.add_argument("--profile", default="book", help="the recipe's profile (default: book)")
         self.parser.add_argument("--seeds", type=int, nargs="+", default=seeds or [0], help="seeds to run")
+        self.parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                                 help="run the trainings on the Dask cluster at ADDRESS (tcp://host:8786) "
+                                      "instead of a local one (default: $PGAE_DASK_SCHEDULER, else local)")
         self.args: argparse.Namespace | None = None
 
     def add_original_data(self, default: str | None = DEFAULT_ORIGINAL_DATA,
@@ -112,6 +113,10 @@ class Benchmark:
 
     def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
         self.args = self.parser.parse_args(argv)
+        if self.args.scheduler:
+            from pgae_lite.runs.sweep import SCHEDULER_ENV
+
+            os.environ[SCHEDULER_ENV] = self.args.scheduler     # side_by_side's sweeps go there
         if self.args.threads:
             import torch
 
@@ -143,12 +148,13 @@ class Benchmark:
 
 
 def side_by_side(work, jobs: list[tuple], workers: int) -> list:
-    """``work(*job)`` for each job, ``workers`` processes at a time (spawned), in the jobs' order.
+    """``work(*job)`` for each job, in the jobs' order: each job a unit of one sweep on Dask
+    (:func:`pgae_lite.runs.sweep.run_sweep`), on a local cluster of ``workers`` single-threaded
+    processes, or on the cluster at ``--scheduler`` / ``$PGAE_DASK_SCHEDULER``.
 
-    ``work`` must be a module-level function of the benchmark (spawned workers import it) and
+    ``work`` must be a module-level function of the benchmark (the workers receive it pickled) and
     should set its own threads (one per worker: these networks gain nothing from two).
     """
-    if workers <= 1:
-        return [work(*job) for job in jobs]
-    with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-        return list(pool.map(work, *zip(*jobs)))
+    from pgae_lite.runs.sweep import run_sweep     # here: dask loads only when a sweep runs
+
+    return run_sweep(work, jobs, workers=max(1, workers))

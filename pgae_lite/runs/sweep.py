@@ -1,0 +1,104 @@
+"""Sweeps: many trainings as tasks on a Dask cluster, from one laptop to a lab's cluster.
+
+A benchmark that trains several models (Table 1 over seeds, the ablations, the free-form
+variants: the paper's Sec. 4 measured many times) is a list of *units*: one call
+``work(*args)`` trains and measures one model, on one thread, in its own resumable folder
+(one training = one config digest). :func:`run_sweep` submits every unit as a task to a Dask
+cluster and returns the results in the units' order:
+
+- by default a ``LocalCluster`` on this machine, one single-threaded worker process per core
+  (``workers`` to choose how many);
+- with ``scheduler="tcp://host:8786"`` (or ``$PGAE_DASK_SCHEDULER``) an existing cluster: started
+  by hand (``dask scheduler``, then ``dask worker tcp://host:8786 --nthreads 1`` on each
+  machine), over SSH (``distributed.SSHCluster``) or on SLURM/PBS (``dask-jobqueue``).
+
+A worker that dies in the middle of a unit loses that unit's unsaved epochs only: the scheduler
+gives the task to another worker (up to ``allowed_failures`` times) and the unit resumes from
+its checkpoint. One line of progress (units done, running, left, time left) is printed as units
+finish, each unit's output goes to its own log file, and the dashboard's address is printed.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+from pathlib import Path
+
+SCHEDULER_ENV = "PGAE_DASK_SCHEDULER"
+
+
+def _logged(work, log: str | None, *args):
+    """``work(*args)`` with its output (stdout and stderr) in the file ``log``, if given."""
+    if log is None:
+        return work(*args)
+    Path(log).parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "a", encoding="utf-8") as f, contextlib.redirect_stdout(f), contextlib.redirect_stderr(f):
+        return work(*args)
+
+
+def client_for(scheduler: str | None = None, workers: int | None = None):
+    """A Dask client: on the cluster at ``scheduler`` (else ``$PGAE_DASK_SCHEDULER``), or on a new
+    ``LocalCluster`` of ``workers`` single-threaded processes (default: one per core)."""
+    from distributed import Client, LocalCluster
+
+    address = scheduler or os.environ.get(SCHEDULER_ENV) or None
+    if address:
+        return Client(address)
+    n = workers or os.cpu_count() or 1
+    if not isinstance(n, int) or n < 1:
+        raise ValueError(f"workers must be a whole number >= 1; got {workers!r}")
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    return Client(cluster)
+
+
+def _progress(done: int, running: int, total: int, seconds: list[float], width: int) -> str:
+    left = total - done
+    eta = ""
+    if seconds and left:
+        per_unit = sum(seconds) / len(seconds)
+        eta = f", about {per_unit * left / max(1, width) / 60:.1f} min left"
+    return f"sweep: {done}/{total} units done, {running} running, {left - running} waiting{eta}"
+
+
+def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler: str | None = None,
+              logs: str | Path | None = None, name: str = "sweep") -> list:
+    """``[work(*unit) for unit in units]``, each unit a task on a Dask cluster (see the module).
+
+    ``work`` must be importable or picklable by the workers (a module-level function) and should
+    set its own threads (one: these networks gain nothing from two). ``logs``: a folder for one
+    log file per unit (``NAME-K.log``). A unit that raises makes the sweep raise, naming it.
+    """
+    from distributed import as_completed
+
+    if not units:
+        return []
+    client = client_for(scheduler, workers)
+    try:
+        if client.dashboard_link:
+            print(f"{name}: Dask dashboard at {client.dashboard_link}", flush=True)
+        width = max(1, len(client.scheduler_info().get("workers", {})))
+        futures = [client.submit(_logged, work, None if logs is None else str(Path(logs) / f"{name}-{k}.log"),
+                                 *unit, key=f"{name}-{k}", pure=False)
+                   for k, unit in enumerate(units)]
+        index = {f.key: k for k, f in enumerate(futures)}
+        results: list = [None] * len(units)
+        started, seconds, done = time.perf_counter(), [], 0
+        for future in as_completed(futures):
+            k = index[future.key]
+            if future.status == "error":
+                raise RuntimeError(f"{name}: unit {k} {units[k]!r} failed") from future.exception()
+            results[k] = future.result()
+            done += 1
+            seconds.append((time.perf_counter() - started) * width / done)
+            running = min(width, len(units) - done)
+            print(_progress(done, running, len(units), seconds, width), file=sys.stderr, flush=True)
+        return results
+    finally:
+        cluster = getattr(client, "cluster", None)
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+__all__ = ["SCHEDULER_ENV", "client_for", "run_sweep"]

@@ -1,0 +1,86 @@
+"""The sweep runner (pgae_lite/runs/sweep.py): the same units give the same results, digit for digit,
+on a local cluster of two workers, of one worker, and on a scheduler and two workers started as
+separate processes; a failing unit names itself."""
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+import time
+
+import pytest
+
+from pgae_lite.runs.sweep import run_sweep
+
+
+def train_unit(seed: int) -> dict:
+    """One tiny training of the smoke recipe on the toy data, its Table 1 cells (a sweep's unit)."""
+    import torch
+
+    from pgae_lite.config import get_profile
+    from pgae_lite.data.toy import toy_dataset
+    from pgae_lite.evaluate import evaluate
+    from pgae_lite.train.loop import train
+
+    torch.set_num_threads(1)
+    data = toy_dataset(variations=1, patterns=range(24))
+    profile = get_profile("smoke", seed=seed, epochs=2)
+    trained = train(data, profile, progress=False)
+    cells, _ = evaluate(trained.model, data, trained.normaliser)
+    return {s: c["nrmse"] for s, c in cells.items()}
+
+
+def fails(x: int) -> int:
+    if x == 1:
+        raise ValueError("unit one fails")
+    return x
+
+
+UNITS = [(0,), (1,), (2,)]
+
+
+@pytest.fixture(scope="module")
+def in_process():
+    return [train_unit(*u) for u in UNITS]
+
+
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.timeout(300)
+@pytest.mark.parametrize("workers", [2, 1])
+def test_a_local_cluster_gives_the_numbers_of_one_process(in_process, workers, tmp_path):
+    assert run_sweep(train_unit, UNITS, workers=workers, logs=tmp_path) == in_process
+    assert len(list(tmp_path.glob("sweep-*.log"))) == len(UNITS)       # one log per unit
+
+
+@pytest.mark.timeout(300)
+def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, tmp_path):
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                               "--port", str(port), "--dashboard-address", ":0"], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        time.sleep(3)
+        procs += [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1",
+                                    "--nworkers", "1", "--no-dashboard"], env=env,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for _ in range(2)]
+        time.sleep(5)
+        assert run_sweep(train_unit, UNITS, scheduler=address) == in_process
+    finally:
+        for p in procs:
+            p.terminate()
+        for p in procs:
+            p.wait(timeout=30)
+
+
+@pytest.mark.timeout(120)
+def test_a_failing_unit_names_itself():
+    with pytest.raises(RuntimeError, match=r"unit 1 \(1,\) failed"):
+        run_sweep(fails, [(0,), (1,), (2,)], workers=1)
