@@ -84,3 +84,71 @@ def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, tmp_path):
 def test_a_failing_unit_names_itself():
     with pytest.raises(RuntimeError, match=r"unit 1 \(1,\) failed"):
         run_sweep(fails, [(0,), (1,), (2,)], workers=1)
+
+
+def resumable_unit(seed: int, folder: str) -> dict:
+    """A training that checkpoints every epoch into ``folder`` (and resumes from it), slowed down
+    so that a test can kill its worker in the middle."""
+    import torch
+
+    from pgae_lite.config import get_profile
+    from pgae_lite.data.toy import toy_dataset
+    from pgae_lite.evaluate import evaluate
+    from pgae_lite.train.loop import train
+
+    torch.set_num_threads(1)
+    data = toy_dataset(variations=1, patterns=range(24))
+    profile = get_profile("smoke", seed=seed, epochs=6)
+    def epoch_done(epoch, *_):                       # which epochs this unit trained, across attempts
+        with open(os.path.join(folder, "epochs.txt"), "a") as f:
+            f.write(f"{epoch}\n")
+        time.sleep(1.0)
+
+    trained = train(data, profile, out_dir=folder, progress=False, callback=epoch_done)
+    cells, _ = evaluate(trained.model, data, trained.normaliser)
+    return {s: c["nrmse"] for s, c in cells.items()}
+
+
+@pytest.mark.timeout(300)
+def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path):
+    import signal
+    import threading
+
+    from pgae_lite.train.checkpoint import CHECKPOINT
+
+    whole = resumable_unit(0, str(tmp_path / "uninterrupted"))
+    folder = tmp_path / "killed"
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
+                               "--port", str(port), "--dashboard-address", ":0"], env=env,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    killed = []
+
+    def kill_the_worker_after_a_checkpoint():
+        while not (folder / CHECKPOINT).exists():
+            time.sleep(0.2)
+        procs[1].send_signal(signal.SIGKILL)                 # the worker dies in the middle of the unit
+        procs[1].wait(timeout=30)                            # and is reaped (a nanny would do it)
+        killed.append(True)
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
+                                       "--nthreads", "1", "--no-dashboard", "--no-nanny"], env=env,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+    try:
+        time.sleep(3)
+        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads",
+                                       "1", "--no-dashboard", "--no-nanny"], env=env,
+                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        time.sleep(5)
+        threading.Thread(target=kill_the_worker_after_a_checkpoint, daemon=True).start()
+        (result,) = run_sweep(resumable_unit, [(0, str(folder))], scheduler=address)
+    finally:
+        for p in procs:
+            p.kill()
+        for p in procs:
+            p.wait(timeout=30)
+    assert killed, "the worker was not killed during the unit"
+    epochs = (folder / "epochs.txt").read_text().split()
+    assert epochs.count("1") == 1 and epochs[-1] == "6", epochs      # resumed from its checkpoint, not restarted
+    assert result == whole                          # and gave the numbers of an uninterrupted run
