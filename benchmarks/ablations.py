@@ -109,8 +109,7 @@ def measure(name: str, seed: int, profile_name: str, threads: int | None, epochs
 def main() -> None:
     bench = Benchmark("ablations", __doc__, seeds=[0, 1, 2])
     bench.parser.add_argument("--ablations", nargs="+", default=list(ABLATIONS), choices=list(ABLATIONS))
-    bench.parser.add_argument("--workers", type=int, default=1,
-                              help="models trained side by side, each in its own process")
+    bench.add_workers(1, "trainings")
     bench.parser.add_argument("--epochs", type=int, default=None,
                               help="train the recipe and every change for this many epochs (default: the profile's)")
     args = bench.parse()

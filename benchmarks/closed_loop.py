@@ -81,8 +81,7 @@ def main() -> None:
                               help="send the model's joints to the motors as they are")
     bench.parser.add_argument("--set", nargs="+", type=key_value, default=[], metavar="KEY=VALUE",
                               help="training options changed from the recipe (a candidate recipe)")
-    bench.parser.add_argument("--workers", type=int, default=1,
-                              help="models trained and run side by side, each in its own process")
+    bench.add_workers(1, "trainings")
     args = bench.parse()
     overrides = dict(args.set)
     try:

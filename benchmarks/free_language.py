@@ -177,8 +177,7 @@ def main() -> None:
     bench.parser.add_argument("--trainings", nargs="+", default=["PGAE-BERT", "PGAE-BERT-phrasings",
                                                                   "PGAE-BERT-phrasings-held-out"])
     bench.parser.add_argument("--no-closed", action="store_true", help="open loop only (fast)")
-    bench.parser.add_argument("--workers", type=int, default=1,
-                              help="models measured side by side, each in its own process on one thread")
+    bench.add_workers(1, "trainings")
     bench.add_original_data(None, "the authors' data: each training's canonical Table 1 there, and nothing else")
     bench.parser.add_argument("--time", action="store_true", help="the variant's training time against PGAE-BERT's")
     args = bench.parse()

@@ -94,9 +94,6 @@ class Benchmark:
         self.parser.add_argument("--out", default=None, help=f"result file (default: results/{name}.json)")
         self.parser.add_argument("--profile", default="book", help="the recipe's profile (default: book)")
         self.parser.add_argument("--seeds", type=int, nargs="+", default=seeds or [0], help="seeds to run")
-        self.parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
-                                 help="run the trainings on the Dask cluster at ADDRESS (tcp://host:8786) "
-                                      "instead of a local one (default: $PGAE_DASK_SCHEDULER, else local)")
         self.args: argparse.Namespace | None = None
 
     def add_original_data(self, default: str | None = DEFAULT_ORIGINAL_DATA,
@@ -106,14 +103,20 @@ class Benchmark:
         self.parser.add_argument("--original-data", metavar="PATH", help=f"{help} ({shown})",
                                  default=os.environ.get("PGAE_ORIGINAL_DATA", default) if default else None)
 
-    def add_workers(self, default: int = 1, what: str = "runs") -> None:
-        """``--workers N``: how many ``what`` run at once on this machine (one spelling in every script)."""
+    def add_workers(self, default: int = 1, what: str = "runs", sweep: bool = True) -> None:
+        """``--workers N``: how many ``what`` run at once on this machine (one spelling in every script);
+        with ``sweep``, also ``--scheduler ADDRESS``: the benchmark's sweep (:func:`side_by_side`) on a
+        Dask cluster instead of a local one."""
         self.parser.add_argument("--workers", type=int, default=default,
                                  help=f"{what} at once, in processes of their own (default {default})")
+        if sweep:
+            self.parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                                     help=f"run the {what} on the Dask cluster at ADDRESS (tcp://host:8786) "
+                                          "instead of a local one (default: $PGAE_DASK_SCHEDULER, else local)")
 
     def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
         self.args = self.parser.parse_args(argv)
-        if self.args.scheduler:
+        if getattr(self.args, "scheduler", None):
             from pgae_lite.runs.sweep import SCHEDULER_ENV
 
             os.environ[SCHEDULER_ENV] = self.args.scheduler     # side_by_side's sweeps go there

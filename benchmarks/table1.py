@@ -31,7 +31,7 @@ bench = Benchmark("table1", __doc__, seeds=[0, 1, 2])
 bench.add_original_data()
 bench.parser.add_argument("--sim", action="store_true", help="our simulated data instead of the authors'")
 bench.parser.add_argument("--rows", default="PGAE")
-bench.add_workers(1, "seeds")
+bench.add_workers(1, "seeds", sweep=False)       # its own pool of reproduce runs (not a sweep yet)
 bench.parser.add_argument("--runs", default="benchmarks/out", help="the runs' output folders (resumable)")
 args = bench.parse()
 source = "sim" if args.sim else "original"
