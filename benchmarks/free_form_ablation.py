@@ -57,7 +57,7 @@ ROWS: dict[str, Training] = {
 LOOKUP_ROW = "+ word lookup"
 
 
-def measure_as_is(model, data, norm, cae, profile: str, told, unseen) -> dict:
+def measure_as_is(model, data, norm, cae, profile: str, paraphrases, told, unseen) -> dict:
     """Readback and open-loop execution by both routes, with the model's encoder as it is now."""
     test = data.split("test")
     texts = [input_text("repeat language", t.text) for t in told]
@@ -65,7 +65,7 @@ def measure_as_is(model, data, norm, cae, profile: str, told, unseen) -> dict:
     cells = {"readback_%": round(100 * float(back.correct.mean()), 2),
              "readback_unseen_%": round(100 * float(back.correct[unseen].mean()), 2)}
     for route in ROUTES:
-        table = execute_paraphrases(model, cae, norm, data, load_paraphrases(), closed=False, route=route,
+        table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=False, route=route,
                                     config=get_profile(profile).data, progress=False)
         # a refused instruction is not executed: it counts as not done
         passed = table["open_passed"].fillna(False).to_numpy(dtype=bool)
@@ -94,12 +94,12 @@ def run(row: str, seed: int, profile: str) -> list[dict]:
     if lookup is not None:                    # rows 1 to 4: no lookup
         encoder.word_lookup = None
     rows = [{"row": row, "training": ROWS[row].name, "seed": seed, "train_seconds": round(trained.seconds, 1),
-             **measure_as_is(model, data, norm, cae, profile, told, unseen)}]
+             **measure_as_is(model, data, norm, cae, profile, paraphrases, told, unseen)}]
     if row == "+ tuned top layer":
         encoder.word_lookup = lookup
         rows.append({"row": LOOKUP_ROW, "training": ROWS[row].name, "seed": seed,
                      "train_seconds": round(trained.seconds, 1),
-                     **measure_as_is(model, data, norm, cae, profile, told, unseen)})
+                     **measure_as_is(model, data, norm, cae, profile, paraphrases, told, unseen)})
     for r in rows:
         r["episodes"], r["unseen_episodes"] = len(told), int(unseen.sum())
         r["measure_seconds"] = round(time.perf_counter() - t0, 1)

@@ -51,6 +51,33 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+class HandStartedCluster:
+    """A ``dask scheduler`` and ``dask worker`` processes started by hand, as on a lab's machines."""
+
+    def __init__(self):
+        self.address = f"tcp://127.0.0.1:{free_port()}"
+        self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+        port = self.address.rsplit(":", 1)[1]
+        self.procs = [self._start("dask_scheduler", "--host", "127.0.0.1", "--port", port,
+                                  "--dashboard-address", ":0")]
+        time.sleep(3)
+
+    def _start(self, command: str, *args: str) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, "-m", f"distributed.cli.{command}", *args], env=self.env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def add_worker(self, *options: str) -> subprocess.Popen:
+        worker = self._start("dask_worker", self.address, "--nthreads", "1", "--no-dashboard", *options)
+        self.procs.append(worker)
+        return worker
+
+    def close(self) -> None:
+        for p in self.procs:
+            p.kill()
+        for p in self.procs:
+            p.wait(timeout=30)
+
+
 @pytest.mark.timeout(300)
 @pytest.mark.parametrize("workers", [2, 1])
 def test_a_local_cluster_gives_the_numbers_of_one_process(in_process, workers, tmp_path):
@@ -60,24 +87,14 @@ def test_a_local_cluster_gives_the_numbers_of_one_process(in_process, workers, t
 
 @pytest.mark.timeout(300)
 def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, tmp_path):
-    port = free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                               "--port", str(port), "--dashboard-address", ":0"], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    cluster = HandStartedCluster()
     try:
-        time.sleep(3)
-        procs += [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1",
-                                    "--nworkers", "1", "--no-dashboard"], env=env,
-                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) for _ in range(2)]
+        for _ in range(2):
+            cluster.add_worker()
         time.sleep(5)
-        assert run_sweep(train_unit, UNITS, scheduler=address) == in_process
+        assert run_sweep(train_unit, UNITS, scheduler=cluster.address) == in_process
     finally:
-        for p in procs:
-            p.terminate()
-        for p in procs:
-            p.wait(timeout=30)
+        cluster.close()
 
 
 @pytest.mark.timeout(120)
@@ -118,36 +135,23 @@ def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path):
 
     whole = resumable_unit(0, str(tmp_path / "uninterrupted"))
     folder = tmp_path / "killed"
-    port = free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-    procs = [subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1",
-                               "--port", str(port), "--dashboard-address", ":0"], env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    cluster = HandStartedCluster()
     killed = []
 
-    def kill_the_worker_after_a_checkpoint():
+    def kill_the_worker_after_a_checkpoint(worker):
         while not (folder / CHECKPOINT).exists():
             time.sleep(0.2)
-        procs[1].send_signal(signal.SIGKILL)                 # the worker dies in the middle of the unit
-        procs[1].wait(timeout=30)                            # and is reaped (a nanny would do it)
+        worker.send_signal(signal.SIGKILL)                   # the worker dies in the middle of the unit
+        worker.wait(timeout=30)                              # and is reaped (a nanny would do it)
         killed.append(True)
-        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address,
-                                       "--nthreads", "1", "--no-dashboard", "--no-nanny"], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        cluster.add_worker("--no-nanny")
     try:
-        time.sleep(3)
-        procs.append(subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads",
-                                       "1", "--no-dashboard", "--no-nanny"], env=env,
-                                      stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+        worker = cluster.add_worker("--no-nanny")
         time.sleep(5)
-        threading.Thread(target=kill_the_worker_after_a_checkpoint, daemon=True).start()
-        (result,) = run_sweep(resumable_unit, [(0, str(folder))], scheduler=address)
+        threading.Thread(target=kill_the_worker_after_a_checkpoint, args=(worker,), daemon=True).start()
+        (result,) = run_sweep(resumable_unit, [(0, str(folder))], scheduler=cluster.address)
     finally:
-        for p in procs:
-            p.kill()
-        for p in procs:
-            p.wait(timeout=30)
+        cluster.close()
     assert killed, "the worker was not killed during the unit"
     epochs = (folder / "epochs.txt").read_text().split()
     assert epochs.count("1") == 1 and epochs[-1] == "6", epochs      # resumed from its checkpoint, not restarted

@@ -52,12 +52,10 @@ def client_for(scheduler: str | None = None, workers: int | None = None):
     return Client(cluster)
 
 
-def _progress(done: int, running: int, total: int, seconds: list[float], width: int) -> str:
+def _progress(done: int, running: int, total: int, elapsed: float) -> str:
+    """One line: units done, running and waiting, and the time left at the pace so far."""
     left = total - done
-    eta = ""
-    if seconds and left:
-        per_unit = sum(seconds) / len(seconds)
-        eta = f", about {per_unit * left / max(1, width) / 60:.1f} min left"
+    eta = f", about {elapsed / done * left / 60:.1f} min left" if done and left else ""
     return f"sweep: {done}/{total} units done, {running} running, {left - running} waiting{eta}"
 
 
@@ -83,16 +81,15 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
                    for k, unit in enumerate(units)]
         index = {f.key: k for k, f in enumerate(futures)}
         results: list = [None] * len(units)
-        started, seconds, done = time.perf_counter(), [], 0
+        started, done = time.perf_counter(), 0
         for future in as_completed(futures):
             k = index[future.key]
             if future.status == "error":
                 raise RuntimeError(f"{name}: unit {k} {units[k]!r} failed") from future.exception()
             results[k] = future.result()
             done += 1
-            seconds.append((time.perf_counter() - started) * width / done)
             running = min(width, len(units) - done)
-            print(_progress(done, running, len(units), seconds, width), file=sys.stderr, flush=True)
+            print(_progress(done, running, len(units), time.perf_counter() - started), file=sys.stderr, flush=True)
         return results
     finally:
         cluster = getattr(client, "cluster", None)
