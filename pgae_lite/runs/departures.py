@@ -11,7 +11,7 @@ found is the project's lab log (``experiments/HISTORY.md``), not the book.
 """
 from __future__ import annotations
 
-import statistics
+from statistics import median
 from dataclasses import dataclass
 
 import pandas as pd
@@ -91,18 +91,14 @@ DEPARTURES: tuple[Departure, ...] = (
 )
 
 
-def _median(values: list[float]) -> float:
-    return statistics.median(values)
-
-
 def _ablation(ablation: str, *names: str) -> str:
     said = []
     for name in names:
-        budget = results.value(name, "epochs") if "epochs" in results.value(name) else None
+        budget = results.value(name).get("epochs")
         when = f"in {budget} epochs, " if budget else ""
         frame = results.ablation_frame(ablation, name)
         runs = results.value(name, "runs")
-        seconds = {who: _median([r["train_seconds"] for r in runs if r["ablation"] == who])
+        seconds = {who: median([r["train_seconds"] for r in runs if r["ablation"] == who])
                    for who in ("recipe", ablation)}
         said.append(f"{when}{results.ablation_verdict(frame)}, a training {seconds[ablation] / seconds['recipe']:.2f} "
                     f"times as long ({name}.json)")
@@ -111,7 +107,7 @@ def _ablation(ablation: str, *names: str) -> str:
 
 def _plan_head() -> str:
     runs = results.value("closed_loop", "runs")
-    closed = {t: _median([r["closed_success_%"] for r in runs if r["training"] == t])
+    closed = {t: median([r["closed_success_%"] for r in runs if r["training"] == t])
               for t in ("PGAE", "PGAE-no-plan")}
     return (f"closed loop {closed['PGAE']:.1f}% with it, {closed['PGAE-no-plan']:.1f}% without "
             f"(median of {len(runs) // 3} seeds; closed_loop.json)")
@@ -123,7 +119,7 @@ def scaling_cells(dataset: str) -> dict[str, dict[str, float]]:
     cells = {}
     for scaling in dict.fromkeys(r["scaling"] for r in runs):
         mine = [r for r in runs if r["scaling"] == scaling]
-        cells[scaling] = {view: _median([r["table1"][view]["describe"]["accuracy"] for r in mine])
+        cells[scaling] = {view: median([r["table1"][view]["describe"]["accuracy"] for r in mine])
                           for view in ("self", "opposite")}
         cells[scaling]["seeds"] = len(mine)
     return cells
