@@ -103,12 +103,13 @@ class Benchmark:
         self.parser.add_argument("--original-data", metavar="PATH", help=f"{help} ({shown})",
                                  default=os.environ.get("PGAE_ORIGINAL_DATA", default) if default else None)
 
-    def add_workers(self, default: int = 1, what: str = "runs", sweep: bool = True) -> None:
+    def add_workers(self, default: int | None = 1, what: str = "runs", sweep: bool = True) -> None:
         """``--workers N``: how many ``what`` run at once on this machine (one spelling in every script);
         with ``sweep``, also ``--scheduler ADDRESS``: the benchmark's sweep (:func:`side_by_side`) on a
         Dask cluster instead of a local one."""
         self.parser.add_argument("--workers", type=int, default=default,
-                                 help=f"{what} at once, in processes of their own (default {default})")
+                                 help=f"{what} at once, in processes of their own "
+                                      f"(default {default or 'one per core'})")
         if sweep:
             self.parser.add_argument("--scheduler", metavar="ADDRESS", default=None,
                                      help=f"run the {what} on the Dask cluster at ADDRESS (tcp://host:8786) "

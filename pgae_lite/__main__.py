@@ -75,6 +75,11 @@ def main(argv: list[str] | None = None) -> int:
                           "with one subfolder TRAINING-seedS per model (checkpoint.pt, predictions-ROW.npz) "
                           "(default: runs/original-PROFILE-seedSEED or runs/simulated-PROFILE-seedSEED)")
     rep.add_argument("--device", default=None, help="torch device, e.g. cpu or cuda (default: CUDA if present)")
+    rep.add_argument("--workers", type=int, default=None, metavar="N",
+                     help="on the CPU, train N models side by side, one core each (default: one per core)")
+    rep.add_argument("--scheduler", metavar="ADDRESS", default=None,
+                     help="run the trainings on the Dask cluster at ADDRESS, e.g. tcp://host:8786 (default: "
+                          "$PGAE_DASK_SCHEDULER, else this machine); its workers need the data at the same path")
     rep.add_argument("--no-progress", action="store_true", help="no progress bar")
     sim = sub.add_parser("simulate", help="record the simulated dataset into the cache",
                          description="Record every episode of the profile's dataset (144 patterns x 6 "
@@ -144,9 +149,9 @@ def run_command(args: argparse.Namespace) -> int:
                                 "but empty; unset it to use our simulated data, or set "
                                 "it to the authors' data folder")
     rows = check_arguments(original, args.rows, args.seed, args.seeds, args.epochs,
-                           args.device, args.pretrained_model, args.out, cli=True)
+                           args.device, args.pretrained_model, args.out, args.workers, args.scheduler, cli=True)
     reproduce(original, profile, args.seed, args.out, args.epochs, args.device,
-              not args.no_progress, rows, args.seeds, args.pretrained_model)
+              not args.no_progress, rows, args.seeds, args.pretrained_model, args.workers, args.scheduler)
     return 0
 
 

@@ -142,7 +142,8 @@ def test_reproduce_self_and_opposite_rows_over_two_seeds(original_data, original
     printed = capsys.readouterr().out
     assert "80.56" in printed and "65.28" in printed and "±" in printed      # both paper rows, mean ± std
     assert {p.name for p in out.iterdir()} == {"PGAE-views-seed0", "PGAE-views-seed1", "results.json",
-                                               "predictions.npz"}
+                                               "predictions.npz", "logs"}
+    assert len(list((out / "logs").glob("table1-*.log"))) == 2     # two units, side by side: a log each
     for seed in (0, 1):
         assert {p.name for p in (out / f"PGAE-views-seed{seed}").iterdir()} == {
             "checkpoint.pt", "predictions-PGAE-self.npz", "predictions-PGAE-opposite.npz"}

@@ -99,7 +99,7 @@ def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, tmp_path):
 
 @pytest.mark.timeout(120)
 def test_a_failing_unit_names_itself():
-    with pytest.raises(RuntimeError, match=r"unit 1 \(1,\) failed"):
+    with pytest.raises(RuntimeError, match=r"unit 1 \(1\) failed: ValueError: unit one fails"):
         run_sweep(fails, [(0,), (1,), (2,)], workers=1)
 
 

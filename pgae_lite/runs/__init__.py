@@ -4,6 +4,7 @@
 - ``trainings``   trainings that are not Table 1's rows: PGAE-no-plan, the free-form variants
 - ``new_colour``  the same pipeline for a world with a new colour (appendix A3)
 - ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
+- ``table1_unit`` one training of one seed, measured on its rows: a unit of reproduce's sweep
 - ``sweep``       many trainings as tasks on a Dask cluster, from a laptop to a lab's cluster
 - ``results``     the committed result files, read and quoted by the book and the README
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect

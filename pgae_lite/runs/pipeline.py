@@ -18,8 +18,6 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
@@ -31,6 +29,7 @@ from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load
 from pgae_lite.config import Profile, Training, as_training, get_profile, training_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.data.simulated import DatasetConfig, episode_name, generate, to_dataset, training_frames
+from pgae_lite.runs.sweep import run_sweep
 from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest, make_folder
 
 if TYPE_CHECKING:
@@ -200,13 +199,14 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
                   progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
     """Several of :func:`trained_pgae`'s models, by training name; those not cached are trained side by side.
 
-    On a CPU the missing models train at the same time, each in its own process on
-    one thread, ``workers`` at once (default: one per core). These networks are
-    small: on the book's 2-core machine one training on both cores ran no faster
-    than on one (A2, "Where the time goes"), so two trainings side by side take
-    about the time of one. With a GPU, or one model to train, they train one after
-    another in this process, as :func:`trained_pgae` does. Workers are spawned, so a
-    script that calls this needs the usual ``if __name__ == "__main__":`` guard.
+    On a CPU the missing models train at the same time, each a unit of a sweep
+    (:func:`pgae_lite.runs.sweep.run_sweep`) on a worker process of one thread, ``workers``
+    at once (default: one per core). These networks are small: on the book's 2-core
+    machine one training on both cores ran no faster than on one (A2, "Where the time
+    goes"), so two trainings side by side take about the time of one. With a GPU, or one
+    model to train, they train one after another in this process, as :func:`trained_pgae`
+    does. Workers are spawned, so a script that calls this needs the usual
+    ``if __name__ == "__main__":`` guard.
     """
     import torch
 
@@ -220,11 +220,11 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
         if progress:
             names = ", ".join(t.name for t in todo)
             print(f"training {names} side by side, {workers} at a time, one core each ...", flush=True)
-        with ProcessPoolExecutor(workers, mp_context=get_context("spawn")) as pool:
-            for training, seconds in zip(todo, pool.map(_train_alone, todo, [prof] * len(todo),
-                                                        [seed] * len(todo))):
-                if progress:
-                    print(f"{training.name}: trained in {seconds / 60:.1f} min", flush=True)
+        seconds = run_sweep(_train_alone, [(t, prof, seed) for t in todo], workers=workers, name="training",
+                            progress=False)
+        for training, s in zip(todo, seconds):
+            if progress:
+                print(f"{training.name}: trained in {s / 60:.1f} min", flush=True)
     return {t.name: trained_pgae(t, prof, seed, device, progress) for t in trainings}
 
 

@@ -20,37 +20,40 @@ Output folder layout (``out``)::
     predictions.npz              the first row's predictions for the first seed
     TRAINING-seedS/checkpoint.pt one folder per training and seed (resumable)
     TRAINING-seedS/predictions-ROW.npz
+    logs/table1-K.log            each unit's output, when the units ran as a sweep
+
+Each (training, seed) is one unit (:mod:`pgae_lite.runs.table1_unit`); several run side by
+side on this machine's cores, or on a Dask cluster (:mod:`pgae_lite.runs.sweep`).
 """
 from __future__ import annotations
 
 import json
 import math
 import os
-import shutil
 import statistics
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from pgae_lite.bert.pretrained import model_source
-from pgae_lite.config import ROWS, Profile, get_profile, training_profile
+from pgae_lite.config import ROWS, Profile, get_profile
 from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table
-from pgae_lite.train.loop import train
+from pgae_lite.evaluate import PAPER_TABLE, Predictions, format_table
+from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
+from pgae_lite.runs.table1_unit import check_made_on, remember_dataset, table1_unit, unit_profile
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.util.storage import atomic_path, atomic_write, atomic_write_text, make_folder
+from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.world.words import TEST_SIGNALS
 
-SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
 CELLS = ("accuracy", "nrmse", "nrmse_padded")
 MAX_SEEDS = 100                                     # models per row: a sane count
 #: The command line's name of each argument :func:`check_arguments` checks.
 FLAGS = {"original_data": "--original-data", "rows": "--rows", "seed": "--seed",
          "seeds": "--seeds", "epochs": "--epochs", "device": "--device",
-         "pretrained_model": "--pretrained-model", "out_dir": "--out"}
+         "pretrained_model": "--pretrained-model", "out_dir": "--out", "workers": "--workers",
+         "scheduler": "--scheduler"}
 
 
 def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
@@ -76,7 +79,7 @@ def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
 
 
 def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained_model,
-                    out_dir, cli: bool = False) -> list[str]:
+                    out_dir, workers=None, scheduler=None, cli: bool = False) -> list[str]:
     """:func:`reproduce`'s arguments checked before any data is read; returns the rows.
 
     A bad one raises a one-sentence :class:`~pgae_lite.util.errors.PGAELiteError` that
@@ -92,6 +95,13 @@ def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained
                             f"2**32 - 1 = {MAX_SEED}")
     if epochs is not None:
         whole_number(name["epochs"], epochs, 1)
+    if workers is not None:
+        whole_number(name["workers"], workers, 1)
+    instance_of(name["scheduler"], scheduler, str, "a Dask scheduler's address, e.g. tcp://host:8786",
+                optional=True)
+    if scheduler is not None and not scheduler.strip():
+        raise ArgumentError(f"{name['scheduler']} is empty (an unset variable?); give a Dask scheduler's "
+                            f"address, e.g. tcp://host:8786, or leave {name['scheduler']} out to run here")
     torch_device(name["device"], device)
     defaults = {"original_data": "our simulated data",
                 "out_dir": "runs/DATA-PROFILE-seedSEED"}
@@ -154,59 +164,81 @@ def summarise(per_seed: list[dict[str, dict[str, float]]]) -> tuple[dict, dict]:
 
 def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Path,
                profile: Profile, device: str | None = None, progress: bool = True,
-               pretrained_model: str | None = None) -> dict:
-    """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``."""
+               pretrained_model: str | None = None, original_data: str | Path | None = None,
+               workers: int | None = None, scheduler: str | None = None) -> dict:
+    """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``.
+
+    Each (training, seed) is one unit (:func:`~pgae_lite.runs.table1_unit.table1_unit`). On the CPU
+    with more than one unit they run as a sweep (:func:`~pgae_lite.runs.sweep.run_sweep`): ``workers``
+    single-threaded processes here (default: one per core, at most one per unit), or the Dask
+    cluster at ``scheduler`` (or ``$PGAE_DASK_SCHEDULER``), whose workers read ``original_data``
+    at the same path, or make this profile's simulated data in their own cache. Else, or with
+    ``workers=1``, one after another in this process. Every unit's model is checked against
+    ``dataset`` (:func:`~pgae_lite.runs.table1_unit.check_made_on`).
+    """
     dataset.split("train"), dataset.split("test")    # both needed: refused now, not after the trainings
     make_folder(out)                 # a file in the way, or no permission: one sentence
+    source = None if original_data is None else str(Path(original_data).resolve())
+    trainings = list(dict.fromkeys(ROWS[r][0] for r in rows))
+    units = [(source, profile, t, seed, [r for r in rows if ROWS[r][0] == t], str(Path(out).resolve()), device,
+              pretrained_model) for t in trainings for seed in seeds]
+    if _as_sweep(len(units), device, workers, scheduler):
+        done = run_sweep(table1_unit, units, workers=min(workers or os.cpu_count() or 1, len(units)),
+                         scheduler=scheduler, logs=Path(out) / "logs", name="table1", progress=progress)
+    else:
+        remember_dataset(source, profile, dataset)
+        done = [table1_unit(*unit, progress=progress) for unit in units]
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:
         report["rows"][row] = {"training": ROWS[row][0], "paper": {
             s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE[row].items()}, "seeds": {}}
-    for training in dict.fromkeys(ROWS[r][0] for r in rows):
-        for seed in seeds:
-            prof = training_profile(replace(profile, train=replace(profile.train, seed=seed)), training,
-                                    pretrained_model)
-            folder = out / f"{training}-seed{seed}"
-            trained = train(dataset, prof, out_dir=folder, device=device, progress=progress)
-            info = report["trainings"].setdefault(training, {"profile": prof.to_dict(), "train_seconds": {}})
-            info["train_seconds"][str(seed)] = trained.seconds
-            self_results = None
-            for row in (r for r in rows if ROWS[r][0] == training):
-                opposite = ROWS[row][1]
-                results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=opposite)
-                if opposite:
-                    if self_results is None:
-                        self_results, _ = evaluate(trained.model, dataset, trained.normaliser)
-                    results |= {s: self_results[s] for s in SHARED_WITH_SELF}
-                else:
-                    self_results = results
-                save_predictions(folder / f"predictions-{row}.npz", preds)
-                report["rows"][row]["seeds"][str(seed)] = results
+    for unit in done:
+        prof = unit_profile(profile, unit["training"], unit["seed"], pretrained_model)
+        folder = out / f"{unit['training']}-seed{unit['seed']}"
+        check_made_on(unit, dataset, prof, folder)    # trained elsewhere on other features: an error
+        info = report["trainings"].setdefault(unit["training"], {"profile": prof.to_dict(), "train_seconds": {}})
+        info["train_seconds"][str(unit["seed"])] = unit["seconds"]
+        for row, cells in unit["cells"].items():
+            make_folder(folder)
+            save_predictions(folder / f"predictions-{row}.npz", unit["predictions"][row])
+            report["rows"][row]["seeds"][str(unit["seed"])] = cells
     for row in rows:
         mean, std = summarise([report["rows"][row]["seeds"][str(s)] for s in seeds])
         report["rows"][row] |= {"mean": mean, "std": std}
-    first = out / f"{ROWS[rows[0]][0]}-seed{seeds[0]}" / f"predictions-{rows[0]}.npz"
-    with atomic_path(out / "predictions.npz") as tmp:   # never through a link, never half-written
-        shutil.copyfile(first, tmp)
+    first = next(u for u in done if u["training"] == ROWS[rows[0]][0] and u["seed"] == seeds[0])
+    save_predictions(out / "predictions.npz", first["predictions"][rows[0]])
     return report
+
+
+def _as_sweep(units: int, device: str | None, workers: int | None, scheduler: str | None) -> bool:
+    """Whether :func:`run_table1` runs its units as a sweep: on a given cluster always; here, on the
+    CPU with more than one unit and more than one worker (a GPU trains one model at a time)."""
+    if scheduler or os.environ.get(SCHEDULER_ENV):
+        return True
+    import torch
+
+    cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
+    return cpu and units > 1 and (workers or os.cpu_count() or 1) > 1
 
 
 def reproduce(original_data: str | Path | None = None, profile: str | None = None, seed: int = 0,
               out_dir: str | Path | None = None, epochs: int | None = None,
               device: str | None = None, progress: bool = True, rows: str | list[str] | None = None,
-              seeds: int = 1, pretrained_model: str | None = None) -> dict:
+              seeds: int = 1, pretrained_model: str | None = None, workers: int | None = None,
+              scheduler: str | None = None) -> dict:
     """Table 1 from scratch: train (or resume) and evaluate the chosen rows; write and print the results.
 
     ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
     our simulated data (simulator -> CAE -> PGAE, each step cached). ``rows``: see
     :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
-    per row are trained, with seeds ``seed, seed + 1, ...``. Every argument is checked
-    before any data is read (:func:`check_arguments`).
+    per row are trained, with seeds ``seed, seed + 1, ...``: on the CPU, side by side on ``workers``
+    cores (default: all), or on the Dask cluster at ``scheduler`` (:func:`run_table1`). Every
+    argument is checked before any data is read (:func:`check_arguments`).
     """
     from pgae_lite.data.original import load_original
 
     rows = check_arguments(original_data, rows, seed, seeds, epochs, device,
-                           pretrained_model, out_dir)
+                           pretrained_model, out_dir, workers, scheduler)
     prof = get_profile(profile, **({} if epochs is None else {"epochs": epochs}))
     if original_data is not None:
         dataset, source = load_original(original_data), "original"
@@ -217,7 +249,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     out = Path(out_dir if out_dir is not None else default_out)
     t0 = time.perf_counter()
     report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,
-                        pretrained_model)
+                        pretrained_model, original_data, workers, scheduler)
     report |= {"data": dataset.source if original_data is None else str(original_data),
                "wall_seconds": time.perf_counter() - t0}
     nonfinite = write_results(out / "results.json", report)

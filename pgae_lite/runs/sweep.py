@@ -52,6 +52,12 @@ def client_for(scheduler: str | None = None, workers: int | None = None):
     return Client(cluster)
 
 
+def _label(unit: tuple) -> str:
+    """A unit's arguments in a few words: a recipe or a training by its name, others as written (cut short)."""
+    shown = [a.name if isinstance(getattr(a, "name", None), str) else repr(a) for a in unit]
+    return "(" + ", ".join(s if len(s) <= 60 else s[:57] + "..." for s in shown) + ")"
+
+
 def _progress(done: int, running: int, total: int, elapsed: float) -> str:
     """One line: units done, running and waiting, and the time left at the pace so far."""
     left = total - done
@@ -60,12 +66,13 @@ def _progress(done: int, running: int, total: int, elapsed: float) -> str:
 
 
 def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler: str | None = None,
-              logs: str | Path | None = None, name: str = "sweep") -> list:
+              logs: str | Path | None = None, name: str = "sweep", progress: bool = True) -> list:
     """``[work(*unit) for unit in units]``, each unit a task on a Dask cluster (see the module).
 
     ``work`` must be importable or picklable by the workers (a module-level function) and should
     set its own threads (one: these networks gain nothing from two). ``logs``: a folder for one
-    log file per unit (``NAME-K.log``). A unit that raises makes the sweep raise, naming it.
+    log file per unit (``NAME-K.log``). A unit that raises makes the sweep raise, naming it and
+    its error. ``progress``: print the dashboard's address and the progress line.
     """
     from distributed import as_completed
 
@@ -73,7 +80,7 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
         return []
     client = client_for(scheduler, workers)
     try:
-        if client.dashboard_link:
+        if progress and client.dashboard_link:
             print(f"{name}: Dask dashboard at {client.dashboard_link}", flush=True)
         width = max(1, len(client.scheduler_info().get("workers", {})))
         futures = [client.submit(_logged, work, None if logs is None else str(Path(logs) / f"{name}-{k}.log"),
@@ -85,11 +92,15 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
         for future in as_completed(futures):
             k = index[future.key]
             if future.status == "error":
-                raise RuntimeError(f"{name}: unit {k} {units[k]!r} failed") from future.exception()
+                error = future.exception()
+                raise RuntimeError(f"{name}: unit {k} {_label(units[k])} failed: {type(error).__name__}: {error}"
+                                   ) from error
             results[k] = future.result()
             done += 1
             running = min(width, len(units) - done)
-            print(_progress(done, running, len(units), time.perf_counter() - started), file=sys.stderr, flush=True)
+            if progress:
+                print(_progress(done, running, len(units), time.perf_counter() - started), file=sys.stderr,
+                      flush=True)
         return results
     finally:
         cluster = getattr(client, "cluster", None)

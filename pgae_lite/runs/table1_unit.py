@@ -1,0 +1,112 @@
+"""One unit of a Table 1 sweep: one training for one seed, trained (or resumed), then measured on its rows.
+
+Paper, Sec. 4 and Table 1. ``reproduce`` over seeds is a list of these units, run one after
+another in this process or as tasks on a Dask cluster (:mod:`pgae_lite.runs.sweep`). A unit
+runs wherever its worker is, so it finds its data there (:func:`worker_dataset`): the
+authors' folder at the same path (a shared disk, or a copy at that path), or this profile's
+simulated data from the worker's own cache, recorded and encoded there if missing. It
+returns everything the report needs (cells, predictions, training time) and the data
+statistics its model was trained on, which the sweep's caller checks against its own data
+(:func:`check_made_on`): a worker whose CAE gave other features fails the sweep with a
+:class:`~pgae_lite.train.checkpoint.DataMismatchError`, never a silently wrong cell.
+"""
+from __future__ import annotations
+
+import platform
+import time
+from dataclasses import replace
+from pathlib import Path
+
+from pgae_lite.config import ROWS, Profile, training_profile
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.evaluate import evaluate
+from pgae_lite.train.checkpoint import check_trained_on, training_split
+from pgae_lite.train.loop import train
+from pgae_lite.util.storage import FolderBusyError, cache_dir, config_digest
+
+SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
+BUSY_POLL_SECONDS = 5       # how often a unit looks whether another run's training of its model has ended
+_LOADED: dict[tuple, PGAEDataset] = {}              # this process's data, loaded once per source
+
+
+def _data_key(original_data: str | None, profile: Profile) -> tuple:
+    return (original_data,) if original_data else ("simulated", config_digest(profile.data.to_dict()),
+                                                   config_digest(profile.cae.to_dict()))
+
+
+def worker_dataset(original_data: str | None, profile: Profile, device: str | None = None) -> PGAEDataset:
+    """The data a unit trains and measures on, loaded once per process: the authors' folder
+    ``original_data``, else ``profile``'s simulated data from this machine's cache (made if missing)."""
+    key = _data_key(original_data, profile)
+    if key not in _LOADED:
+        if original_data:
+            from pgae_lite.data.original import load_original
+            _LOADED[key] = load_original(original_data)
+        else:
+            from pgae_lite.runs.pipeline import simulated_dataset
+            _LOADED[key] = simulated_dataset(profile, device, progress=False)
+    return _LOADED[key]
+
+
+def remember_dataset(original_data: str | None, profile: Profile, dataset: PGAEDataset) -> None:
+    """Units run in this process use ``dataset`` (already loaded by the caller) for that source."""
+    _LOADED[_data_key(original_data, profile)] = dataset
+
+
+def unit_profile(profile: Profile, training: str, seed: int, pretrained_model: str | None = None) -> Profile:
+    """The recipe of one unit: ``profile`` with the training's changes and the seed."""
+    return training_profile(replace(profile, train=replace(profile.train, seed=seed)), training, pretrained_model)
+
+
+def _train_when_free(dataset: PGAEDataset, prof: Profile, folder: Path, device, progress: bool, name: str):
+    """``train`` into ``folder``; while another run trains this very model there (two sweeps writing
+    one results folder), wait for it and then load what it trained."""
+    announced = False
+    while True:
+        try:
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=name)
+        except FolderBusyError:
+            if not announced:
+                print(f"{folder}: another run is training this model; waiting for it ...", flush=True)
+            announced = True
+            time.sleep(BUSY_POLL_SECONDS)
+
+
+def table1_unit(original_data: str | None, profile: Profile, training: str, seed: int, rows: list[str],
+                out: str, device: str | None = None, pretrained_model: str | None = None,
+                progress: bool = False) -> dict:
+    """Train (or resume) ``training`` with ``seed`` into ``out/TRAINING-seedS``, measure its ``rows``.
+
+    Returns ``{"training", "seed", "seconds", "cells": {row: cells}, "predictions": {row: {signal:
+    Predictions}}, "normaliser": the statistics it was trained on, "made_on": host and cache}``.
+    """
+    dataset = worker_dataset(original_data, profile, device)
+    prof = unit_profile(profile, training, seed, pretrained_model)
+    trained = _train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
+    cells, predictions, self_results = {}, {}, None
+    for row in rows:
+        opposite = ROWS[row][1]
+        results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=opposite)
+        if opposite:
+            if self_results is None:
+                self_results, _ = evaluate(trained.model, dataset, trained.normaliser)
+            results |= {s: self_results[s] for s in SHARED_WITH_SELF}
+        else:
+            self_results = results
+        cells[row], predictions[row] = results, preds
+    return {"training": training, "seed": seed, "seconds": trained.seconds, "cells": cells,
+            "predictions": predictions, "normaliser": trained.normaliser.state_dict(),
+            "made_on": f"{platform.node()}, cache {cache_dir()}"}
+
+
+def check_made_on(result: dict, dataset: PGAEDataset, prof: Profile, folder: Path) -> None:
+    """Raise :class:`~pgae_lite.train.checkpoint.DataMismatchError` unless the unit's model was trained
+    on ``dataset`` (the caller's): the same statistics of its training samples, on any machine."""
+    cfg = prof.train
+    fitted = Normaliser.fit(training_split(dataset, cfg.max_train_samples), cfg.vision_scaling).state_dict()
+    check_trained_on({"normaliser": result["normaliser"]}, fitted, folder,
+                     f"{dataset.source}; the model was trained on {result['made_on']}")
+
+
+__all__ = ["SHARED_WITH_SELF", "check_made_on", "remember_dataset", "table1_unit", "unit_profile",
+           "worker_dataset"]
