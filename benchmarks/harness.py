@@ -14,8 +14,9 @@
 
 The work runs under the ``__main__`` guard: recording the simulated data
 (:func:`pgae_lite.data.simulated.generate`, which :func:`pgae_lite.runs.pipeline.simulated_dataset`
-and ``trained_cae`` call when the cache lacks it) spawns worker processes, and
-each re-imports the script; unguarded, they would run the benchmark again.
+and ``trained_cae`` call when the cache lacks it) and a sweep's local cluster
+(:func:`side_by_side`) spawn worker processes, and each re-imports the script;
+unguarded, they would run the benchmark again.
 
 A result file is JSON::
 

@@ -8,6 +8,10 @@ skipped with a message when it is absent.
 from __future__ import annotations
 
 import os
+import socket
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -131,3 +135,48 @@ def interrupt_training():
         with pytest.raises(Interrupt):
             train(dataset, profile, out_dir=out_dir, progress=False, device="cpu", callback=stop(epoch))
     return run
+
+
+class HandStartedCluster:
+    """A ``dask scheduler`` and ``dask worker`` processes started by hand, as on a lab's machines."""
+
+    def __init__(self):
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        self.address = f"tcp://127.0.0.1:{port}"
+        self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+        self.procs = [self._start(self.env, "dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
+                                  "--dashboard-address", ":0")]
+        time.sleep(3)
+
+    def _start(self, env: dict, command: str, *args: str) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, "-m", f"distributed.cli.{command}", *args], env=env,
+                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+    def add_worker(self, *options: str, **env: str) -> subprocess.Popen:
+        """A worker of one thread; ``env``: its environment's differences (another machine's cache)."""
+        worker = self._start({**self.env, **env}, "dask_worker", self.address, "--nthreads", "1",
+                             "--no-dashboard", *options)
+        self.procs.append(worker)
+        return worker
+
+    def wait_for(self, workers: int) -> None:
+        from distributed import Client
+
+        with Client(self.address) as client:
+            client.wait_for_workers(workers, timeout=120)
+
+    def close(self) -> None:
+        for p in self.procs:
+            p.kill()
+        for p in self.procs:
+            p.wait(timeout=30)
+
+
+@pytest.fixture
+def dask_cluster():
+    """A scheduler started by hand (add its workers with ``add_worker``); everything killed after the test."""
+    cluster = HandStartedCluster()
+    yield cluster
+    cluster.close()

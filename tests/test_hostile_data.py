@@ -15,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -350,6 +351,21 @@ def test_a_second_run_in_the_same_folder_fails_clearly(toy_short, tmp_path):
     train(toy_short, _tiny(), out_dir=tmp_path, progress=False, device="cpu")
     assert (tmp_path / CHECKPOINT).exists() and not (tmp_path / LOCK_FILE).exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == [CHECKPOINT]
+
+
+def test_a_lock_left_by_a_dead_machine_goes_stale(toy_short, tmp_path):
+    """A lock of another machine's process cannot be checked by its pid: it is alive while its holder
+    touches it (a sweep's worker on a shared disk), and stale once untouched for LOCK_STALE_SECONDS."""
+    from pgae_lite.util.storage import LOCK_STALE_SECONDS
+
+    lock = tmp_path / LOCK_FILE
+    lock.write_text("another-machine:4242")
+    with pytest.raises(FolderBusyError, match="another-machine:4242"):
+        train(toy_short, _tiny(), out_dir=tmp_path, progress=False, device="cpu")
+    old = time.time() - LOCK_STALE_SECONDS - 5
+    os.utime(lock, (old, old))                     # that machine died: nobody touched its lock since
+    train(toy_short, _tiny(), out_dir=tmp_path, progress=False, device="cpu")
+    assert (tmp_path / CHECKPOINT).exists() and not lock.exists()
 
 
 # ------------------------------------------------------------------ the training API

@@ -4,9 +4,6 @@ separate processes; a failing unit names itself."""
 from __future__ import annotations
 
 import os
-import socket
-import subprocess
-import sys
 import time
 
 import pytest
@@ -45,39 +42,6 @@ def in_process():
     return [train_unit(*u) for u in UNITS]
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class HandStartedCluster:
-    """A ``dask scheduler`` and ``dask worker`` processes started by hand, as on a lab's machines."""
-
-    def __init__(self):
-        self.address = f"tcp://127.0.0.1:{free_port()}"
-        self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-        port = self.address.rsplit(":", 1)[1]
-        self.procs = [self._start("dask_scheduler", "--host", "127.0.0.1", "--port", port,
-                                  "--dashboard-address", ":0")]
-        time.sleep(3)
-
-    def _start(self, command: str, *args: str) -> subprocess.Popen:
-        return subprocess.Popen([sys.executable, "-m", f"distributed.cli.{command}", *args], env=self.env,
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-
-    def add_worker(self, *options: str) -> subprocess.Popen:
-        worker = self._start("dask_worker", self.address, "--nthreads", "1", "--no-dashboard", *options)
-        self.procs.append(worker)
-        return worker
-
-    def close(self) -> None:
-        for p in self.procs:
-            p.kill()
-        for p in self.procs:
-            p.wait(timeout=30)
-
-
 @pytest.mark.timeout(300)
 @pytest.mark.parametrize("workers", [2, 1])
 def test_a_local_cluster_gives_the_numbers_of_one_process(in_process, workers, tmp_path):
@@ -86,15 +50,11 @@ def test_a_local_cluster_gives_the_numbers_of_one_process(in_process, workers, t
 
 
 @pytest.mark.timeout(300)
-def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, tmp_path):
-    cluster = HandStartedCluster()
-    try:
-        for _ in range(2):
-            cluster.add_worker()
-        time.sleep(5)
-        assert run_sweep(train_unit, UNITS, scheduler=cluster.address) == in_process
-    finally:
-        cluster.close()
+def test_a_cluster_started_by_hand_gives_the_same_numbers(in_process, dask_cluster):
+    for _ in range(2):
+        dask_cluster.add_worker()
+    dask_cluster.wait_for(2)
+    assert run_sweep(train_unit, UNITS, scheduler=dask_cluster.address) == in_process
 
 
 @pytest.mark.timeout(120)
@@ -127,7 +87,7 @@ def resumable_unit(seed: int, folder: str) -> dict:
 
 
 @pytest.mark.timeout(300)
-def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path):
+def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path, dask_cluster):
     import signal
     import threading
 
@@ -135,7 +95,7 @@ def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path):
 
     whole = resumable_unit(0, str(tmp_path / "uninterrupted"))
     folder = tmp_path / "killed"
-    cluster = HandStartedCluster()
+    cluster = dask_cluster
     killed = []
 
     def kill_the_worker_after_a_checkpoint(worker):
@@ -145,13 +105,10 @@ def test_a_killed_worker_loses_only_its_unsaved_epochs(tmp_path):
         worker.wait(timeout=30)                              # and is reaped (a nanny would do it)
         killed.append(True)
         cluster.add_worker("--no-nanny")
-    try:
-        worker = cluster.add_worker("--no-nanny")
-        time.sleep(5)
-        threading.Thread(target=kill_the_worker_after_a_checkpoint, args=(worker,), daemon=True).start()
-        (result,) = run_sweep(resumable_unit, [(0, str(folder))], scheduler=cluster.address)
-    finally:
-        cluster.close()
+    worker = cluster.add_worker("--no-nanny")
+    cluster.wait_for(1)
+    threading.Thread(target=kill_the_worker_after_a_checkpoint, args=(worker,), daemon=True).start()
+    (result,) = run_sweep(resumable_unit, [(0, str(folder))], scheduler=cluster.address)
     assert killed, "the worker was not killed during the unit"
     epochs = (folder / "epochs.txt").read_text().split()
     assert epochs.count("1") == 1 and epochs[-1] == "6", epochs      # resumed from its checkpoint, not restarted

@@ -32,7 +32,7 @@ import time
 import warnings
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
-from multiprocessing import get_context
+from multiprocessing import current_process, get_context
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -261,7 +261,8 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
 
 
 def _run(jobs: list, workers: int) -> Iterator[dict]:
-    if workers == 1:
+    # A daemon process (a Dask worker's: a sweep's unit on a machine without the data) may not start others.
+    if workers == 1 or current_process().daemon:
         yield from map(_record_and_save, jobs)
         return
     # "spawn": fresh interpreters, safe beside torch threads and inside notebooks.

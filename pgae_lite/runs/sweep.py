@@ -40,6 +40,7 @@ def _logged(work, log: str | None, *args):
 def client_for(scheduler: str | None = None, workers: int | None = None):
     """A Dask client: on the cluster at ``scheduler`` (else ``$PGAE_DASK_SCHEDULER``), or on a new
     ``LocalCluster`` of ``workers`` single-threaded processes (default: one per core)."""
+    import dask
     from distributed import Client, LocalCluster
 
     address = scheduler or os.environ.get(SCHEDULER_ENV) or None
@@ -48,7 +49,11 @@ def client_for(scheduler: str | None = None, workers: int | None = None):
     n = workers or os.cpu_count() or 1
     if not isinstance(n, int) or n < 1:
         raise ValueError(f"workers must be a whole number >= 1; got {workers!r}")
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    # Nothing set in this process's environment before each worker starts (Dask's default sets
+    # MALLOC_TRIM_THRESHOLD_ and OMP_NUM_THREADS here, for every later child of this process too):
+    # each worker sets its own (pgae_lite.runs.sweep_worker).
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": {}}):
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
     return Client(cluster)
 
 
@@ -80,6 +85,9 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
         return []
     client = client_for(scheduler, workers)
     try:
+        from pgae_lite.runs.sweep_worker import OneCoreWorker
+
+        client.register_plugin(OneCoreWorker(), name="pgae-lite-one-core-worker")
         if progress and client.dashboard_link:
             print(f"{name}: Dask dashboard at {client.dashboard_link}", flush=True)
         width = max(1, len(client.scheduler_info().get("workers", {})))

@@ -30,6 +30,8 @@ import pickle
 import re
 import shutil
 import socket
+import threading
+import time
 import uuid
 from pathlib import Path
 from typing import IO, Iterator
@@ -236,6 +238,8 @@ def load_torch(path: str | Path, keys: tuple[str, ...] = (),
 
 
 LOCK_FILE = ".pgae_lite.lock"
+LOCK_BEAT_SECONDS = 60      # a held lock's file is touched this often, so that
+LOCK_STALE_SECONDS = 600    # another machine can tell a dead holder by a file this old
 
 
 def _dead(pid: int) -> bool:
@@ -255,8 +259,11 @@ def _holder(lock: Path) -> str | None:
         host, _, pid = lock.read_text().strip().rpartition(":")
     except OSError:
         return None
-    if host != socket.gethostname():
-        return f"{host}:{pid}"        # another machine's process: it cannot be checked
+    if host != socket.gethostname():  # another machine's process: alive while it touches its lock
+        with contextlib.suppress(OSError):
+            if time.time() - lock.stat().st_mtime > LOCK_STALE_SECONDS:
+                return None
+        return f"{host}:{pid}"
     if not pid.isdigit() or int(pid) == os.getpid():
         return None                   # unreadable, or left by this very process
     return None if _dead(int(pid)) else f"{host}:{pid}"
@@ -279,12 +286,21 @@ def clean_left_behind(folder: Path) -> list[Path]:
     return removed
 
 
+def _beat(lock: Path, stop: threading.Event) -> None:
+    """Touch ``lock`` every :data:`LOCK_BEAT_SECONDS` until ``stop``: its holder is alive."""
+    while not stop.wait(LOCK_BEAT_SECONDS):
+        with contextlib.suppress(OSError):
+            os.utime(lock)
+
+
 @contextlib.contextmanager
 def folder_lock(folder: str | Path) -> Iterator[None]:
     """Hold ``folder``'s lock file while the block runs: a second run there fails.
 
-    The lock file holds ``host:pid``; a lock whose process has died is taken over, and the lock and
-    temporary files that dead runs left in the folder are removed (:func:`clean_left_behind`).
+    The lock file holds ``host:pid``; a lock whose process has died is taken over (on another
+    machine, one not touched for :data:`LOCK_STALE_SECONDS`: its holder touches it every
+    :data:`LOCK_BEAT_SECONDS`), and the lock and temporary files that dead runs left in the
+    folder are removed (:func:`clean_left_behind`).
     """
     lock = make_folder(folder) / LOCK_FILE
     token = f"{socket.gethostname()}:{os.getpid()}"
@@ -314,9 +330,12 @@ def folder_lock(folder: str | Path) -> Iterator[None]:
         mine.unlink(missing_ok=True)
         raise
     clean_left_behind(lock.parent)
+    stop = threading.Event()
+    threading.Thread(target=_beat, args=(lock, stop), daemon=True).start()
     try:
         yield
     finally:
+        stop.set()
         with contextlib.suppress(OSError):
             if lock.read_text() == token:
                 lock.unlink()
