@@ -6,6 +6,7 @@
 - ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
 - ``table1_unit`` one training of one seed, measured on its rows: a unit of reproduce's sweep
 - ``sweep``       many trainings as tasks on a Dask cluster, from a laptop to a lab's cluster
+- ``sweep_worker`` every worker of a sweep set up for these trainings (one thread, malloc thresholds)
 - ``results``     the committed result files, read and quoted by the book and the README
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect
 - ``opposite_scale`` chapter 06's ablation: the two-view model under three scalings
