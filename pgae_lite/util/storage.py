@@ -287,7 +287,7 @@ def clean_left_behind(folder: Path) -> list[Path]:
 
 
 def _beat(lock: Path, stop: threading.Event) -> None:
-    """Touch ``lock`` every :data:`LOCK_BEAT_SECONDS` until ``stop``: its holder is alive."""
+    """Touch ``lock`` every ``LOCK_BEAT_SECONDS`` until ``stop``: its holder is alive."""
     while not stop.wait(LOCK_BEAT_SECONDS):
         with contextlib.suppress(OSError):
             os.utime(lock)
@@ -298,8 +298,8 @@ def folder_lock(folder: str | Path) -> Iterator[None]:
     """Hold ``folder``'s lock file while the block runs: a second run there fails.
 
     The lock file holds ``host:pid``; a lock whose process has died is taken over (on another
-    machine, one not touched for :data:`LOCK_STALE_SECONDS`: its holder touches it every
-    :data:`LOCK_BEAT_SECONDS`), and the lock and temporary files that dead runs left in the
+    machine, one not touched for ``LOCK_STALE_SECONDS``: its holder touches it every
+    ``LOCK_BEAT_SECONDS``), and the lock and temporary files that dead runs left in the
     folder are removed (:func:`clean_left_behind`).
     """
     lock = make_folder(folder) / LOCK_FILE
