@@ -107,6 +107,7 @@ LAYERS = {
     "cae": {"util"},
     "model": {"data", "world", "util"},
     "bert": {"model", "data", "world", "util"},
+    "family": {"bert", "model", "data", "world", "util"},
     "evaluate": {"model", "data", "world", "util"},
     "viz": {"model", "data", "world", "util"},
     "train": {"bert", "model", "data", "world", "util"},

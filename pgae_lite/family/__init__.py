@@ -1,0 +1,7 @@
+"""The family: PGAE's predecessors (PRAE, PVAE) and successor (PTAE), on this package's parts.
+
+PGAE paper, Sec. 2: PRAE (Yamada et al., RA-L 2018) and PVAE (Özdemir et al., ICDL 2021) bind two
+separate autoencoders with a loss, and so must be configured per translation direction.
+
+- ``binding``     the binding loss that pulls paired action and description codes together
+"""

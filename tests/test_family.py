@@ -1,0 +1,64 @@
+"""The family's parts (pgae_lite/family/): PRAE's and PVAE's binding loss."""
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+import torch
+
+from pgae_lite.family.binding import binding_loss
+from pgae_lite.util.errors import ArgumentError
+
+
+def by_hand(z_language, z_action, margin):
+    """The binding loss written out pair by pair, with plain Python numbers."""
+    b = len(z_language)
+    d = [[math.dist(z_action[i], z_language[j]) for j in range(b)] for i in range(b)]
+    pull = sum(d[i][i] for i in range(b)) / b
+    push = sum(max(0.0, margin + d[j][j] - d[i][j]) + max(0.0, margin + d[i][i] - d[i][j])
+               for i, j in itertools.product(range(b), repeat=2) if i != j) / b ** 2
+    return pull + push
+
+
+def test_the_loss_is_its_equation():
+    torch.manual_seed(0)
+    z_language, z_action = torch.randn(5, 3, dtype=torch.float64), torch.randn(5, 3, dtype=torch.float64)
+    for margin in (0.0, 1.0, 2.5):
+        expected = by_hand(z_language.tolist(), z_action.tolist(), margin)
+        assert binding_loss(z_language, z_action, margin).item() == pytest.approx(expected, rel=1e-12)
+
+
+def test_bound_and_separated_codes_cost_nothing_and_a_swap_costs():
+    corners = torch.eye(4, dtype=torch.float64) * 3.0            # pairs 3 * sqrt(2) > 1 apart
+    assert binding_loss(corners, corners).item() == pytest.approx(0.0, abs=1e-12)
+    swapped = corners[[1, 0, 2, 3]]                              # two descriptions bound to the wrong actions
+    assert binding_loss(swapped, corners).item() > 1.0
+
+
+def test_descending_it_pulls_pairs_together_and_pushes_others_apart():
+    torch.manual_seed(1)
+    z_language = torch.randn(6, 4, requires_grad=True)
+    z_action = torch.randn(6, 4, requires_grad=True)
+    optimiser = torch.optim.SGD([z_language, z_action], lr=0.1)
+    before = binding_loss(z_language, z_action).item()
+    for _ in range(300):
+        optimiser.zero_grad()
+        binding_loss(z_language, z_action).backward()
+        optimiser.step()
+    with torch.no_grad():
+        d = torch.cdist(z_action, z_language)
+        nearest = d.argmin(dim=1)                                # each action's nearest description
+    assert binding_loss(z_language, z_action).item() < before / 5
+    assert nearest.tolist() == list(range(6))                    # is its own
+
+
+@pytest.mark.parametrize("shapes", [((4, 3), (4, 2)), ((4, 3), (5, 3)), ((4,), (4,))])
+def test_codes_of_other_shapes_are_refused(shapes):
+    with pytest.raises(ArgumentError, match="two \\(batch, dimension\\) tensors of one shape"):
+        binding_loss(torch.zeros(shapes[0]), torch.zeros(shapes[1]))
+
+
+def test_a_negative_margin_is_refused():
+    with pytest.raises(ArgumentError, match="margin must be a number >= 0"):
+        binding_loss(torch.zeros(2, 2), torch.zeros(2, 2), margin=-1.0)
