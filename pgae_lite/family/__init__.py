@@ -4,4 +4,5 @@ PGAE paper, Sec. 2: PRAE (Yamada et al., RA-L 2018) and PVAE (Özdemir et al., I
 separate autoencoders with a loss, and so must be configured per translation direction.
 
 - ``binding``     the binding loss that pulls paired action and description codes together
+- ``prae``        PRAE: two autoencoders bound by that loss, translating by their cross paths
 """
