@@ -65,11 +65,14 @@ def test_a_negative_margin_is_refused():
 
 
 # ------------------------------------------------------------------ PRAE
-def prae_inputs(tensors, index):
-    """PRAE's inputs for samples ``index``: the description's words (no signal), the action, the targets."""
+def prae_inputs(tensors, index, alternative=None):
+    """PRAE's inputs for samples ``index``: the description's words (no signal; ``alternative``: which of
+    the 8, default the first), the action, the targets."""
     from pgae_lite.model.signals import make_batch, signal_ids
 
-    b = make_batch(tensors, index, signal_ids("repeat both", len(index)), torch.zeros(len(index), dtype=torch.long))
+    if alternative is None:
+        alternative = torch.zeros(len(index), dtype=torch.long)
+    b = make_batch(tensors, index, signal_ids("repeat both", len(index)), alternative)
     return dict(tokens=b.lang_tokens[:, 1:], token_lengths=b.lang_lengths - 1, inputs=b.action_input,
                 lengths=b.action_lengths, target_words=b.lang_target, vision=b.dec_vision, start=b.start_joints), b
 
@@ -118,3 +121,56 @@ def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(t
     with torch.no_grad():                          # bound: the action's code reads out as its description
         described = model.describe(x["inputs"], x["lengths"]).argmax(-1)
     assert (described == b.lang_target).all(1).float().mean().item() == 1.0
+
+
+# ------------------------------------------------------------------ PVAE
+def test_the_kl_term_is_its_equation_and_torchs():
+    from pgae_lite.family.pvae import kl_divergence
+
+    torch.manual_seed(2)
+    mean, log_var = torch.randn(3, 4, dtype=torch.float64), torch.randn(3, 4, dtype=torch.float64)
+    by_hand = sum(0.5 * sum(math.exp(v) - v - 1 + m * m for m, v in zip(ms, vs))
+                  for ms, vs in zip(mean.tolist(), log_var.tolist())) / 3
+    assert kl_divergence(mean, log_var).item() == pytest.approx(by_hand, rel=1e-12)
+    q = torch.distributions.Normal(mean, (0.5 * log_var).exp())
+    p = torch.distributions.Normal(torch.zeros_like(mean), torch.ones_like(mean))
+    by_torch = torch.distributions.kl_divergence(q, p).sum(-1).mean().item()
+    assert kl_divergence(mean, log_var).item() == pytest.approx(by_torch)
+
+
+def test_a_pvae_sample_is_the_mean_with_the_authors_small_noise():
+    from pgae_lite.family.pvae import PVAE, SAMPLING_STD
+
+    torch.manual_seed(3)
+    mean = torch.full((20_000, 2), 5.0)
+    z = PVAE.sample(mean, torch.zeros_like(mean))                # s = 1: the noise alone, N(0, 0.1^2)
+    assert (z - mean).std().item() == pytest.approx(SAMPLING_STD, rel=0.03)
+    assert (z - mean).mean().abs().item() < 0.01
+
+
+def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
+    """Every step draws one of the 8 equivalent descriptions of each action; the cross path then
+    describes each action with one of its 8 (the one-to-many translation PRAE was not made for)."""
+    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.family.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
+    from pgae_lite.model.config import ModelConfig
+
+    torch.manual_seed(0)
+    tensors = Normaliser.fit(toy_short.split("train")).tensors(toy_short)
+    model = PVAE(ModelConfig(units=16, time_stride=1))
+    optimiser = torch.optim.Adam(model.parameters(), lr=3e-3)
+    index = torch.arange(24)
+    for _ in range(500):
+        x, b = prae_inputs(tensors, index, alternative=torch.randint(0, 8, (24,)))
+        logits, joints, mean_l, mean_a, log_var_l, log_var_a = model(**x)
+        loss = (torch.nn.functional.cross_entropy(logits.transpose(1, 2), b.lang_target)
+                + ((joints - b.joint_target) ** 2)[b.joint_mask].mean()
+                + BINDING_WEIGHT * binding_loss(mean_l, mean_a)
+                + KL_WEIGHT * (kl_divergence(mean_l, log_var_l) + kl_divergence(mean_a, log_var_a)))
+        optimiser.zero_grad()
+        loss.backward()
+        optimiser.step()
+    with torch.no_grad():
+        words = model.describe(x["inputs"], x["lengths"]).argmax(-1)[:, :3]             # (24, 3)
+    one_of_eight = (words[:, None] == tensors["descriptions"][index]).all(-1).any(-1)   # (24,)
+    assert one_of_eight.all(), one_of_eight
