@@ -4,6 +4,7 @@ from __future__ import annotations
 import itertools
 import math
 
+import numpy as np
 import pytest
 import torch
 
@@ -121,6 +122,24 @@ def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(t
     with torch.no_grad():                          # bound: the action's code reads out as its description
         described = model.describe(x["inputs"], x["lengths"]).argmax(-1)
     assert (described == b.lang_target).all(1).float().mean().item() == 1.0
+    check_the_configured_cells(model, toy_short, tensors)
+
+
+def check_the_configured_cells(model, data, tensors):
+    """Table 1's cells of a configured model: words or joints per signal, N.A. (None) for the rest."""
+    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.family.configured import configured_predictions, evaluate_configured
+
+    normaliser = Normaliser.fit(data.split("train"))
+    cells, preds = evaluate_configured(model, data, normaliser, split="train")
+    for signal, words in (("describe", True), ("repeat language", True), ("execute", False), ("repeat action", False)):
+        assert (cells[signal]["accuracy"] is None) != words, signal
+        assert (cells[signal]["nrmse"] is None) == words, signal
+        assert cells[signal]["n"] == len(data.split("train"))
+    assert math.isfinite(cells["execute"]["nrmse"]) and 0 <= cells["describe"]["accuracy"] <= 100
+    assert all(t == "" for t in preds["execute"].text) and np.isnan(preds["describe"].joints).all()
+    trained = configured_predictions(model, data.subset(np.arange(24)), normaliser, "describe")
+    assert trained.correct.all()                   # the samples it trained on, described across
 
 
 # ------------------------------------------------------------------ PVAE
