@@ -193,3 +193,27 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
         words = model.describe(x["inputs"], x["lengths"]).argmax(-1)[:, :3]             # (24, 3)
     one_of_eight = (words[:, None] == tensors["descriptions"][index]).all(-1).any(-1)   # (24,)
     assert one_of_eight.all(), one_of_eight
+
+
+# ------------------------------------------------------------------ training the family
+@pytest.mark.parametrize("name", ["PRAE", "PVAE"])
+def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
+    from pgae_lite.family.train import train_family
+    from pgae_lite.model.config import ModelConfig
+    from pgae_lite.train.config import TrainConfig
+
+    recipe = TrainConfig(epochs=6, batch_size=16, input_noise=0.0, joint_input_noise=0.0)
+    cfg = ModelConfig(units=16, time_stride=1)
+    first = train_family(name, toy_short, cfg, recipe, device="cpu")
+    words, joints = [[h[k] for h in first.history] for k in ("words", "joints")]
+    assert words[-1] < words[0] and joints[-1] < joints[0]
+    assert (first.history[-1]["kl"] > 0) == (name == "PVAE")            # PRAE has no KL term
+    again = train_family(name, toy_short, cfg, recipe, device="cpu")
+    assert again.history == first.history                               # the same seed, the same numbers
+
+
+def test_an_unknown_family_model_is_refused(toy_short):
+    from pgae_lite.family.train import train_family
+
+    with pytest.raises(ValueError, match="unknown family model 'PTAE'; the options are: PRAE, PVAE"):
+        train_family("PTAE", toy_short)

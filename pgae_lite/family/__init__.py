@@ -6,5 +6,6 @@ separate autoencoders with a loss, and so must be configured per translation dir
 - ``binding``     the binding loss that pulls paired action and description codes together
 - ``prae``        PRAE: two autoencoders bound by that loss, translating by their cross paths
 - ``pvae``        PVAE: PRAE with a variational bottleneck per modality (means, log-variances, KL)
+- ``train``       training PRAE and PVAE: both autoencoders at once, bound by the binding loss
 - ``configured``  Table 1's cells of a model configured per direction, N.A. where it has no path
 """

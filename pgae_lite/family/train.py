@@ -1,0 +1,104 @@
+"""Training PRAE and PVAE: both autoencoders at once, bound by the binding loss.
+
+PGAE paper, Sec. 2 (PRAE, PVAE) and Sec. 4 ("Training Details", for the shared parts). Each
+step takes a batch of paired samples, and each autoencoder rebuilds its own modality::
+
+    L = CE(words) + MSE(joints) + w_bind * L_bind(z_L, z_A)           PRAE (w_bind = 1)
+      + KL(mu_L, s_L) + KL(mu_A, s_A)                                   PVAE (w_bind = 2, on the means)
+
+PRAE reads one description per action (the first of the 8: its paper's one-to-one data); PVAE
+draws one of the 8 equivalent descriptions for each sample at each step, as its authors do.
+The words' weights and the joints' MSE are PGAE's (:func:`pgae_lite.train.loss.pgae_loss`), and
+so are the optimiser, its schedule and the input noise of the ``book`` recipe (``recipe``).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import torch
+
+from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.family.binding import binding_loss
+from pgae_lite.family.prae import PRAE
+from pgae_lite.family.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
+from pgae_lite.model.config import ModelConfig
+from pgae_lite.model.signals import make_batch, signal_ids
+from pgae_lite.train.config import TrainConfig
+from pgae_lite.train.loss import add_input_noise, lr_factor, pgae_loss
+from pgae_lite.util.storage import default_device, training_threads
+from pgae_lite.world.words import word_weights
+
+MODELS = {"PRAE": PRAE, "PVAE": PVAE}
+
+
+@dataclass
+class FamilyTrained:
+    """A trained PRAE or PVAE, the normaliser of its data, its loss per epoch and its training time (s)."""
+
+    model: PRAE
+    normaliser: Normaliser
+    history: list[dict]
+    seconds: float
+
+
+def family_loss(model: PRAE, batch, weights: torch.Tensor) -> tuple[torch.Tensor, dict]:
+    """The loss of one batch (see the module) and its terms."""
+    x = dict(tokens=batch.lang_tokens[:, 1:], token_lengths=batch.lang_lengths - 1,   # the words, no signal
+             inputs=batch.action_input, lengths=batch.action_lengths, target_words=batch.lang_target,
+             vision=batch.dec_vision, start=batch.start_joints, steps=batch.joint_mask.sum(1))
+    out = model(**x)
+    _, words, joints = pgae_loss({"logits": out[0], "joints": out[1]}, batch, weights)
+    if isinstance(model, PVAE):
+        mean_l, mean_a, log_var_l, log_var_a = out[2:]
+        bind = binding_loss(mean_l, mean_a)                                   # on the means
+        kl = kl_divergence(mean_l, log_var_l) + kl_divergence(mean_a, log_var_a)
+        total = words + joints + BINDING_WEIGHT * bind + KL_WEIGHT * kl
+    else:
+        bind, kl = binding_loss(out[2], out[3]), torch.zeros(())
+        total = words + joints + bind
+    return total, {"words": words.item(), "joints": joints.item(), "binding": bind.item(), "kl": kl.item()}
+
+
+def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None = None,
+                 recipe: TrainConfig | None = None, device: str | None = None) -> FamilyTrained:
+    """Train ``name`` (``"PRAE"`` or ``"PVAE"``) on the training split of ``dataset``."""
+    if name not in MODELS:
+        raise ValueError(f"unknown family model {name!r}; the options are: {', '.join(MODELS)}")
+    recipe, device = recipe or TrainConfig(), torch.device(device or default_device())
+    train_set = dataset.split("train")
+    normaliser = Normaliser.fit(train_set, recipe.vision_scaling)
+    with training_threads(device):
+        torch.manual_seed(recipe.seed)
+        model = MODELS[name](model_cfg or ModelConfig()).to(device)
+        data = normaliser.tensors(train_set, device)
+        weights = word_weights().to(device)
+        gen = torch.Generator().manual_seed(recipe.seed)
+        optimiser = torch.optim.AdamW(model.parameters(), lr=recipe.lr, weight_decay=recipe.weight_decay)
+        n, history, step, t0 = len(train_set), [], 0, time.perf_counter()
+        steps = recipe.epochs * -(-n // recipe.batch_size)
+        for _ in range(recipe.epochs):
+            model.train()
+            terms = []
+            for index in torch.randperm(n, generator=gen).split(recipe.batch_size):
+                alternative = (torch.randint(0, 8, (len(index),), generator=gen) if name == "PVAE"
+                               else torch.zeros(len(index), dtype=torch.long))      # PRAE: one description
+                batch = make_batch(data, index, signal_ids("repeat both", len(index)), alternative)
+                batch.action_input = add_input_noise(batch.action_input, recipe.input_noise,
+                                                     recipe.joint_input_noise)
+                for group in optimiser.param_groups:                                 # warm-up, cosine decay
+                    group["lr"] = recipe.lr * lr_factor(step, steps, recipe.warmup, recipe.schedule)
+                loss, parts = family_loss(model, batch, weights)
+                optimiser.zero_grad()
+                loss.backward()
+                if recipe.clip:
+                    torch.nn.utils.clip_grad_norm_(model.parameters(), recipe.clip)
+                optimiser.step()
+                terms.append(parts)
+                step += 1
+            history.append({k: sum(t[k] for t in terms) / len(terms) for k in terms[0]})
+        model.eval()
+    return FamilyTrained(model, normaliser, history, time.perf_counter() - t0)
+
+
+__all__ = ["FamilyTrained", "MODELS", "family_loss", "train_family"]
