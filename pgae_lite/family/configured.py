@@ -3,7 +3,7 @@
 PGAE paper, Sec. 4: PVAE "has to be set in the specific configuration" for each task, so it
 "cannot output joint values when it is configured to be used for action-to-language
 translation", and when it executes a description it "is not trained to generate descriptions
-(<EOS> in this case)" (N.A.). Each of the four test signals is one configuration here:
+(<EOS> in this case)" (N.A.). Each of the four test signals is one configuration here::
 
     | signal          | path                                | words  | joints |
     |-----------------|-------------------------------------|--------|--------|
