@@ -73,9 +73,10 @@ def prae_inputs(tensors, index, alternative=None):
 
     if alternative is None:
         alternative = torch.zeros(len(index), dtype=torch.long)
+    from pgae_lite.family.prae import paired_inputs
+
     b = make_batch(tensors, index, signal_ids("repeat both", len(index)), alternative)
-    return dict(tokens=b.lang_tokens[:, 1:], token_lengths=b.lang_lengths - 1, inputs=b.action_input,
-                lengths=b.action_lengths, target_words=b.lang_target, vision=b.dec_vision, start=b.start_joints), b
+    return paired_inputs(b), b
 
 
 def test_prae_rebuilds_each_modality_from_its_code_and_translates_only_across(toy_tensors):

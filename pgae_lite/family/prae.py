@@ -29,6 +29,14 @@ from pgae_lite.model.pgae import ActionDecoder, ActionEncoder, LanguageDecoder, 
 SHARED_DIM = 100      # the authors' shared (code) dimension
 
 
+def paired_inputs(batch) -> dict:
+    """PRAE's inputs from a ``"repeat both"`` :class:`~pgae_lite.model.signals.SignalBatch`: the
+    description's words without the signal (PRAE reads no signal), the action and the decoders' inputs."""
+    return dict(tokens=batch.lang_tokens[:, 1:], token_lengths=batch.lang_lengths - 1,
+                inputs=batch.action_input, lengths=batch.action_lengths, target_words=batch.lang_target,
+                vision=batch.dec_vision, start=batch.start_joints)
+
+
 class PRAE(nn.Module):
     """Two autoencoders, language and action, whose codes z_L and z_A the binding loss ties together."""
 
@@ -75,4 +83,4 @@ class PRAE(nn.Module):
         return self.action_decoder(self.language_code(tokens, token_lengths), vision, start, steps)
 
 
-__all__ = ["PRAE", "SHARED_DIM"]
+__all__ = ["PRAE", "SHARED_DIM", "paired_inputs"]

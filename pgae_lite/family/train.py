@@ -20,7 +20,7 @@ import torch
 
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.family.binding import binding_loss
-from pgae_lite.family.prae import PRAE
+from pgae_lite.family.prae import PRAE, paired_inputs
 from pgae_lite.family.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.signals import make_batch, signal_ids
@@ -44,10 +44,7 @@ class FamilyTrained:
 
 def family_loss(model: PRAE, batch, weights: torch.Tensor) -> tuple[torch.Tensor, dict]:
     """The loss of one batch (see the module) and its terms."""
-    x = dict(tokens=batch.lang_tokens[:, 1:], token_lengths=batch.lang_lengths - 1,   # the words, no signal
-             inputs=batch.action_input, lengths=batch.action_lengths, target_words=batch.lang_target,
-             vision=batch.dec_vision, start=batch.start_joints, steps=batch.joint_mask.sum(1))
-    out = model(**x)
+    out = model(**paired_inputs(batch), steps=batch.joint_mask.sum(1))
     _, words, joints = pgae_loss({"logits": out[0], "joints": out[1]}, batch, weights)
     if isinstance(model, PVAE):
         mean_l, mean_a, log_var_l, log_var_a = out[2:]

@@ -30,7 +30,8 @@ from pgae_lite.config import Profile, Training, as_training, get_profile, traini
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.data.simulated import DatasetConfig, episode_name, generate, to_dataset, training_frames
 from pgae_lite.runs.sweep import run_sweep
-from pgae_lite.util.storage import CorruptCheckpointError, FolderBusyError, cache_dir, config_digest, make_folder
+from pgae_lite.util.storage import (CorruptCheckpointError, FolderBusyError, cache_dir, config_digest,
+                                    default_device, make_folder)
 
 if TYPE_CHECKING:
     from pgae_lite.train.loop import Trained
@@ -156,25 +157,35 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
     waits for it and then loads its model.
     """
     from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError
-    from pgae_lite.train.loop import train
 
     training = as_training(training)
     base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
     dataset = _with_both_splits(simulated_dataset(base, device, progress))
     prof = training_profile(base, training)
     folder = _model_folder(prof, training.name)
-    announced = False
     while True:
         try:
-            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=training.name)
+            return train_when_free(dataset, prof, folder, device, progress, training.name, announce=progress)
         # Damaged, or saved with other data statistics (the folder's name fixes the data and CAE, so an
         # older pgae_lite scaled them otherwise): trained again, like the CAE.
         except (CorruptCheckpointError, DataMismatchError) as e:
             warnings.warn(f"cached model not used, training it again: {e}", stacklevel=2)
             (folder / CHECKPOINT).unlink()
-        except FolderBusyError:           # another process trains this very model into the cache:
-            if progress and not announced:  # wait for it, then load what it trained
-                print(f"{training.name}: another process is training this model; waiting for it ...", flush=True)
+
+
+def train_when_free(dataset: PGAEDataset, prof: Profile, folder: Path, device: str | None, progress: bool,
+                    name: str, announce: bool = True) -> "Trained":
+    """``train`` into ``folder``; while another process trains this very model there (two chapters, or
+    two sweeps, side by side), wait for it (said once, if ``announce``) and then load what it trained."""
+    from pgae_lite.train.loop import train
+
+    announced = False
+    while True:
+        try:
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=name)
+        except FolderBusyError:
+            if announce and not announced:
+                print(f"{name}: another process is training this model; waiting for it ...", flush=True)
             announced = True
             time.sleep(BUSY_POLL_SECONDS)
 
@@ -212,7 +223,7 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
 
     trainings = [as_training(t) for t in trainings]
     prof = get_profile(profile)                                     # a name is resolved once, here
-    cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
+    cpu = torch.device(device or default_device()).type == "cpu"
     todo = [t for t in {t.name: t for t in trainings}.values() if not _finished(t, prof, seed)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
@@ -240,5 +251,5 @@ def _finished(training: Training, profile: Profile, seed: int) -> bool:
         return False
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "cae_path", "cached_cae",
-           "cached_dataset", "made_otherwise"]
+__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "train_when_free", "cae_path",
+           "cached_cae", "cached_dataset", "made_otherwise"]

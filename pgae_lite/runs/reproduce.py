@@ -44,7 +44,7 @@ from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
 from pgae_lite.runs.table1_unit import check_made_on, remember_dataset, table1_unit, unit_profile
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
+from pgae_lite.util.storage import atomic_write, atomic_write_text, default_device, make_folder
 from pgae_lite.world.words import TEST_SIGNALS
 
 CELLS = ("accuracy", "nrmse", "nrmse_padded")
@@ -217,7 +217,7 @@ def _as_sweep(units: int, device: str | None, workers: int | None, scheduler: st
         return True
     import torch
 
-    cpu = (device or ("cuda" if torch.cuda.is_available() else "cpu")) == "cpu"
+    cpu = torch.device(device or default_device()).type == "cpu"
     return cpu and units > 1 and (workers or os.cpu_count() or 1) > 1
 
 

@@ -13,7 +13,6 @@ statistics its model was trained on, which the sweep's caller checks against its
 from __future__ import annotations
 
 import platform
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -21,11 +20,10 @@ from pgae_lite.config import ROWS, Profile, training_profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.evaluate import evaluate
 from pgae_lite.train.checkpoint import check_trained_on, training_split
-from pgae_lite.train.loop import train
-from pgae_lite.util.storage import FolderBusyError, cache_dir, config_digest
+from pgae_lite.runs.pipeline import simulated_dataset, train_when_free
+from pgae_lite.util.storage import cache_dir, config_digest
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
-BUSY_POLL_SECONDS = 5       # how often a unit looks whether another run's training of its model has ended
 _LOADED: dict[tuple, PGAEDataset] = {}              # this process's data, loaded once per source
 
 
@@ -43,7 +41,6 @@ def worker_dataset(original_data: str | None, profile: Profile, device: str | No
             from pgae_lite.data.original import load_original
             _LOADED[key] = load_original(original_data)
         else:
-            from pgae_lite.runs.pipeline import simulated_dataset
             _LOADED[key] = simulated_dataset(profile, device, progress=False)
     return _LOADED[key]
 
@@ -58,20 +55,6 @@ def unit_profile(profile: Profile, training: str, seed: int, pretrained_model: s
     return training_profile(replace(profile, train=replace(profile.train, seed=seed)), training, pretrained_model)
 
 
-def _train_when_free(dataset: PGAEDataset, prof: Profile, folder: Path, device, progress: bool, name: str):
-    """``train`` into ``folder``; while another run trains this very model there (two sweeps writing
-    one results folder), wait for it and then load what it trained."""
-    announced = False
-    while True:
-        try:
-            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=name)
-        except FolderBusyError:
-            if not announced:
-                print(f"{folder}: another run is training this model; waiting for it ...", flush=True)
-            announced = True
-            time.sleep(BUSY_POLL_SECONDS)
-
-
 def table1_unit(original_data: str | None, profile: Profile, training: str, seed: int, rows: list[str],
                 out: str, device: str | None = None, pretrained_model: str | None = None,
                 progress: bool = False) -> dict:
@@ -82,7 +65,7 @@ def table1_unit(original_data: str | None, profile: Profile, training: str, seed
     """
     dataset = worker_dataset(original_data, profile, device)
     prof = unit_profile(profile, training, seed, pretrained_model)
-    trained = _train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
+    trained = train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
     cells, predictions, self_results = {}, {}, None
     for row in rows:
         opposite = ROWS[row][1]
