@@ -21,11 +21,12 @@ import sys
 ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 
 
-# Copies of config.PROFILE_ENV, config.PROFILE_NAMES and config.ROWS (tests/test_cli.py checks that they
-# agree): importing config loads torch (seconds), and ``--help`` stays instant.
+# Copies of config.PROFILE_ENV, config.PROFILE_NAMES, config.ROWS and config.FAMILY_ROWS (tests/test_cli.py
+# checks that they agree): importing config loads torch (seconds), and ``--help`` stays instant.
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")
 ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
+FAMILY_ROW_NAMES = ("PTAE",)
 
 
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
@@ -56,8 +57,8 @@ def main(argv: list[str] | None = None) -> int:
                      help=f"training recipe (default: ${PROFILE_ENV}, else 'book')")
     rep.add_argument("--rows", default="PGAE", metavar="ROWS",
                      help=f"comma-separated rows of Table 1 to train and evaluate: {', '.join(ROW_NAMES)}, "
-                          "or 'all' (default: PGAE). PGAE-self and PGAE-opposite are one model trained on "
-                          "both agents' views")
+                          f"or 'all' (default: PGAE), and of the family beside it: {', '.join(FAMILY_ROW_NAMES)}. "
+                          "PGAE-self and PGAE-opposite are one model trained on both agents' views")
     rep.add_argument("--seed", type=int, default=0,
                      help="random seed, 0 to 2**32 - 1 (default 0): same seed, same "
                           "numbers")

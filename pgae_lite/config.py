@@ -12,9 +12,9 @@ line, a chapter, a benchmark): :func:`get_profile`. Below that, functions take `
 values. The environment variable ``PGAE_LITE_PROFILE`` picks the default profile;
 :func:`profile_name` is the only code that reads it.
 
-Table 1's rows (:data:`ROWS`) are trainings (:data:`TRAININGS`): what each changes in a
-profile (:func:`training_profile`). Trainings that are not Table 1 rows are built where they
-are used (:mod:`pgae_lite.runs.trainings`).
+Table 1's rows (:data:`ROWS`) and the family's beside them (:data:`FAMILY_ROWS`) are trainings
+(:data:`TRAININGS`): what each changes in a profile (:func:`training_profile`). Trainings that
+are not rows are built where they are used (:mod:`pgae_lite.runs.trainings`).
 """
 from __future__ import annotations
 
@@ -160,14 +160,23 @@ class Training:
     name: str
     model: dict = field(default_factory=dict)
     train: dict = field(default_factory=dict)
+    # the model's own authors' settings, over the ``paper`` profile (PGAE's paper's) only
+    paper_model: dict = field(default_factory=dict)
+    paper_train: dict = field(default_factory=dict)
 
 
-#: Table 1's trainings, by name.
+#: The trainings of Table 1's rows and of the family's (PTAE), by name.
 TRAININGS: dict[str, Training] = {t.name: t for t in (
     Training("PGAE"),
     Training("PGAE-BERT", model={"language_encoder": "pretrained"}),
     # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
     Training("PGAE-views", train={"opposite_prob": 0.5}),
+    # PTAE (model/ptae.py): the crossmodal transformer in place of the GMU, 128 wide in the book. Its paper's
+    # model: 256 wide, feed-forward 1024, dropout 0.25, frames without positions; its training: Adam 1e-5,
+    # batch 6, 2,500 epochs. Deviation from paper: at a constant rate (theirs decays in steps).
+    Training("PTAE", model={"bottleneck": "crossmodal-transformer", "hidden": 128},
+             paper_model={"hidden": 256, "feedforward": 1024, "dropout": 0.25, "frame_positions": False},
+             paper_train={"epochs": 2500}),
 )}
 #: row -> (training, evaluated on the opposite agent's actions?)
 ROWS: dict[str, tuple[str, bool]] = {
@@ -176,6 +185,10 @@ ROWS: dict[str, tuple[str, bool]] = {
     "PGAE-self": ("PGAE-views", False),
     "PGAE-opposite": ("PGAE-views", True),
 }
+#: The family's rows beside Table 1's (not in PGAE's Table 1; benchmarks/family.py's table): ``reproduce
+#: --rows`` takes them by name, ``--rows all`` means Table 1's.
+FAMILY_ROWS: dict[str, tuple[str, bool]] = {"PTAE": ("PTAE", False)}
+EVERY_ROW: dict[str, tuple[str, bool]] = {**ROWS, **FAMILY_ROWS}
 
 
 def as_training(training: Training | str) -> Training:
@@ -183,7 +196,7 @@ def as_training(training: Training | str) -> Training:
     if isinstance(training, Training):
         return training
     if training not in TRAININGS:
-        raise ArgumentError(f"unknown training {training!r}; Table 1's trainings are: {', '.join(TRAININGS)}; "
+        raise ArgumentError(f"unknown training {training!r}; the rows' trainings are: {', '.join(TRAININGS)}; "
                             f"the others are Training values (pgae_lite.runs.trainings)")
     return TRAININGS[training]
 
@@ -191,7 +204,9 @@ def as_training(training: Training | str) -> Training:
 def training_profile(base: Profile, training: Training | str, pretrained_model: str | None = None) -> Profile:
     """``base`` with one training's changes (and the pretrained model's name, for a pretrained encoder)."""
     t = as_training(training)
-    model = replace(base.model, **t.model)
+    paper = base.name == "paper"                       # the model's own authors' settings over the paper profile
+    model = replace(base.model, **{**t.model, **(t.paper_model if paper else {})})
     if pretrained_model and model.language_encoder != "lstm":
         model = replace(model, pretrained_model=pretrained_model)
-    return replace(base, model=model, train=replace(base.train, **t.train))
+    train = replace(base.train, **{**t.train, **(t.paper_train if paper else {})})
+    return replace(base, model=model, train=train)

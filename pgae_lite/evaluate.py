@@ -48,7 +48,7 @@ class Predictions:
     joints: np.ndarray     # (N, 100, 5) data units; step 0 = the given start joints; NaN past the length
     target: np.ndarray     # (N, 100, 5) what the joints should have been (same conventions)
     correct: np.ndarray    # (N,) bool, description criterion
-    gate: np.ndarray       # (N, hidden) GMU gate values
+    gate: np.ndarray       # (N, hidden) GMU gate values ((N, 0): a model without a gate, e.g. PTAE)
 
 
 def check_model_inputs(model: PGAE, data: PGAEDataset, normaliser: Normaliser) -> None:
@@ -100,7 +100,7 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
         target = torch.cat([batch.start_joints[:, None], batch.joint_target], 1)
         joints.append(normaliser.joints_to_data(pred).cpu().numpy())
         targets.append(normaliser.joints_to_data(target).cpu().numpy())
-        gates.append(out["gate"].cpu().numpy())
+        gates.append(out["gate"].cpu().numpy() if "gate" in out else np.zeros((len(index), 0), np.float32))
     mask = data.mask[..., None]
     joints_arr = np.where(mask, np.concatenate(joints), np.nan).astype(np.float32)
     target_arr = np.where(mask, np.concatenate(targets), np.nan).astype(np.float32)

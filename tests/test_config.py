@@ -73,17 +73,17 @@ def test_get_profile_copies():
 
 def test_recipes_live_here():
     import pgae_lite.runs.reproduce
-    from pgae_lite.config import ROWS, TRAININGS, training_profile
+    from pgae_lite.config import EVERY_ROW, TRAININGS, training_profile
     from pgae_lite.runs.trainings import NO_PLAN, PHRASINGS, SIDE_TRAININGS
 
-    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-views"]          # Table 1's, and no other
+    assert list(TRAININGS) == ["PGAE", "PGAE-BERT", "PGAE-views", "PTAE"]  # the rows' (Table 1's, PTAE), no other
     assert not set(SIDE_TRAININGS) & set(TRAININGS)
     assert training_profile(get_profile("book"), NO_PLAN).model.plan_keyframes == 0
     assert training_profile(get_profile("book"), PHRASINGS).train.phrasings == 60
-    with pytest.raises(ValueError, match="unknown training 'PGAE-no-plan'; Table 1's trainings are"):
+    with pytest.raises(ValueError, match="unknown training 'PGAE-no-plan'; the rows' trainings are"):
         training_profile(get_profile("book"), "PGAE-no-plan")
-    assert {training for training, _ in ROWS.values()} == set(TRAININGS)
-    assert pgae_lite.runs.reproduce.ROWS is ROWS
+    assert {training for training, _ in EVERY_ROW.values()} == set(TRAININGS)
+    assert pgae_lite.runs.reproduce.EVERY_ROW is EVERY_ROW
     smoke = get_profile("smoke")
     bert = training_profile(smoke, "PGAE-BERT", pretrained_model="bert-base-uncased")
     assert bert.model.language_encoder == "pretrained" and bert.model.pretrained_model == "bert-base-uncased"

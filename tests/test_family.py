@@ -197,7 +197,7 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
 
 
 # ------------------------------------------------------------------ training the family
-@pytest.mark.parametrize("name", ["PRAE", "PVAE"])
+@pytest.mark.parametrize("name", ["PRAE", "PVAE", "PVAE-BERT"])
 def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
     from pgae_lite.family.train import train_family
     from pgae_lite.model.config import ModelConfig
@@ -208,7 +208,7 @@ def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
     first = train_family(name, toy_short, cfg, recipe, device="cpu")
     words, joints = [[h[k] for h in first.history] for k in ("words", "joints")]
     assert words[-1] < words[0] and joints[-1] < joints[0]
-    assert (first.history[-1]["kl"] > 0) == (name == "PVAE")            # PRAE has no KL term
+    assert (first.history[-1]["kl"] > 0) == name.startswith("PVAE")     # PRAE has no KL term
     again = train_family(name, toy_short, cfg, recipe, device="cpu")
     assert again.history == first.history                               # the same seed, the same numbers
 
@@ -216,5 +216,27 @@ def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
 def test_an_unknown_family_model_is_refused(toy_short):
     from pgae_lite.family.train import train_family
 
-    with pytest.raises(ValueError, match="unknown family model 'PTAE'; the options are: PRAE, PVAE"):
+    with pytest.raises(ValueError, match="unknown family model 'PTAE'; the options are: PRAE, PVAE, PVAE-BERT"):
         train_family("PTAE", toy_short)
+
+
+def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(toy_short):
+    """The row as its text, looked up in the encoder's table; the encoder's weights never train."""
+    from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, tokens_to_text
+    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.family.pvae import PVAE
+    from pgae_lite.family.train import train_family
+    from pgae_lite.model.config import ModelConfig
+    from pgae_lite.train.config import TrainConfig
+
+    trained = train_family("PVAE-BERT", toy_short, ModelConfig(units=16, time_stride=1),
+                           TrainConfig(epochs=2, batch_size=16), device="cpu")
+    model = trained.model
+    assert isinstance(model, PVAE) and isinstance(model.language_encoder, PretrainedLanguageEncoder)
+    assert model.to_language_code.in_features == model.language_encoder.output_dim == 384
+    assert not any(p.requires_grad for p in model.language_encoder.parameters())
+    tensors = Normaliser.fit(toy_short.split("train")).tensors(toy_short)
+    x, _ = prae_inputs(tensors, torch.tensor([0, 5]))
+    assert tokens_to_text(x["tokens"][0]).startswith("repeat both ")
+    expected = model.to_language_code(model.language_encoder.encode_texts([tokens_to_text(r) for r in x["tokens"]]))
+    torch.testing.assert_close(model.language_code(x["tokens"], x["token_lengths"]), expected, atol=1e-5, rtol=1e-4)

@@ -5,6 +5,7 @@ and imports nothing of this folder; a model with a pretrained encoder is built h
 passes the encoder's builder in:
 
     model = build_pgae(ModelConfig(language_encoder="pretrained"))    # PGAE-BERT
+    model = build_pgae(ModelConfig(bottleneck="crossmodal-transformer", hidden=256))   # PTAE
 
 - ``"lstm"``: PGAE's LSTM (:class:`~pgae_lite.model.pgae.LanguageEncoder`);
 - ``"pretrained"``: PGAE-BERT's frozen transformer, mean-pooled
@@ -21,6 +22,7 @@ from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.pgae import PGAE, LanguageEncoder
+from pgae_lite.model.ptae import PTAE
 from pgae_lite.world.words import DEFAULT_LEXICON, Lexicon
 
 
@@ -36,8 +38,11 @@ def build_language_encoder(cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON)
     return PretrainedLanguageEncoder(cfg.pretrained_model)
 
 
-def build_pgae(cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON) -> PGAE:
-    """PGAE with the language encoder ``cfg`` names (default: the book recipe's PGAE)."""
+def build_pgae(cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON) -> PGAE | PTAE:
+    """PGAE with the language encoder ``cfg`` names (default: the book recipe's PGAE); with
+    ``bottleneck="crossmodal-transformer"``, PTAE (:mod:`pgae_lite.model.ptae`)."""
+    if cfg is not None and cfg.bottleneck == "crossmodal-transformer":
+        return PTAE(cfg, lexicon)
     return PGAE(cfg, lexicon, make_language_encoder=build_language_encoder)
 
 

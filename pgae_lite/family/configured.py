@@ -47,7 +47,7 @@ def configured_predictions(model, data: PGAEDataset, normaliser: Normaliser, sig
         index = torch.arange(s, min(len(data), s + batch_size))
         b = make_batch(tensors, index, signal_ids("repeat both", len(index)), index % 8)
         if signal in LANGUAGE_IN:
-            code = model.language_code(b.lang_tokens[:, 1:], b.lang_lengths - 1)   # the words, no signal
+            code = model.language_code(b.lang_tokens, b.lang_lengths)               # the description
         else:
             code = model.action_code(b.action_input, b.action_lengths)
         target = torch.cat([b.start_joints[:, None], b.joint_target], 1)            # (B, T, 5)

@@ -23,16 +23,17 @@ from dataclasses import replace
 import torch
 from torch import nn
 
+from pgae_lite.bert.encoders import build_language_encoder
 from pgae_lite.model.config import ModelConfig
-from pgae_lite.model.pgae import ActionDecoder, ActionEncoder, LanguageDecoder, LanguageEncoder
+from pgae_lite.model.pgae import ActionDecoder, ActionEncoder, LanguageDecoder
 
 SHARED_DIM = 100      # the authors' shared (code) dimension
 
 
 def paired_inputs(batch) -> dict:
     """PRAE's inputs from a ``"repeat both"`` :class:`~pgae_lite.model.signals.SignalBatch`: the
-    description's words without the signal (PRAE reads no signal), the action and the decoders' inputs."""
-    return dict(tokens=batch.lang_tokens[:, 1:], token_lengths=batch.lang_lengths - 1,
+    description's tokens (:meth:`PRAE.language_code` reads them), the action and the decoders' inputs."""
+    return dict(tokens=batch.lang_tokens, token_lengths=batch.lang_lengths,
                 inputs=batch.action_input, lengths=batch.action_lengths, target_words=batch.lang_target,
                 vision=batch.dec_vision, start=batch.start_joints)
 
@@ -42,21 +43,31 @@ class PRAE(nn.Module):
 
     # Deviation from paper: both autoencoders use ``cfg``'s LSTMs (the book's: 2 layers of 100
     # units); the authors' language autoencoder has 1 layer of 100 units, the action one 2 of 100.
+    # ``cfg.language_encoder`` may name a pretrained encoder (PVAE-BERT's idea, pgae_lite.bert).
     def __init__(self, cfg: ModelConfig | None = None, shared_dim: int = SHARED_DIM):
         super().__init__()
         cfg = cfg or ModelConfig()
         self.shared_dim = shared_dim
-        self.language_encoder = LanguageEncoder(cfg)
+        self.language_encoder = build_language_encoder(cfg)
         self.action_encoder = ActionEncoder(cfg)
-        self.to_language_code = nn.Linear(cfg.state_dim, shared_dim)    # z_L = W_L f_L + b_L
+        self.to_language_code = nn.Linear(self.language_encoder.output_dim, shared_dim)   # z_L = W_L f_L + b_L
         self.to_action_code = nn.Linear(cfg.state_dim, shared_dim)      # z_A = W_A f_A + b_A
         decoders = replace(cfg, hidden=shared_dim)                      # each decoder starts from a code
         self.language_decoder = LanguageDecoder(decoders)
         self.action_decoder = ActionDecoder(decoders)
 
     def language_code(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
-        """z_L (B, shared) of word tokens (B, N), no signal: PRAE reads the description alone."""
-        return self.to_language_code(self.language_encoder(tokens, lengths))
+        """z_L (B, shared) of a description's ``lang_tokens`` (B, 5): the LSTM reads its words alone (PRAE
+        reads no signal); a pretrained encoder reads the row as its text, "repeat both push red slowly"."""
+        return self.to_language_code(self.language_features(tokens, lengths))
+
+    def language_features(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
+        """f_L: the language encoder's output for ``lang_tokens`` (see :meth:`language_code`)."""
+        if self.language_encoder.reads_free_text:
+            # Deviation from paper: the pretrained encoder reads the signal's words before the description,
+            # a prefix equal for every input, so that it looks the row up in its table of fixed inputs.
+            return self.language_encoder(tokens, lengths)
+        return self.language_encoder(tokens[:, 1:], lengths - 1)            # the words, no signal
 
     def action_code(self, inputs: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         """z_A (B, shared) of [v_t; j_t] (B, T, 35)."""

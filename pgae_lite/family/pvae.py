@@ -39,9 +39,8 @@ class PVAE(PRAE):
 
     def __init__(self, cfg: ModelConfig | None = None, shared_dim: int = SHARED_DIM):
         super().__init__(cfg, shared_dim)
-        state_dim = self.to_language_code.in_features
-        self.language_log_variance = nn.Linear(state_dim, shared_dim)   # log s_L^2 = W f_L + b
-        self.action_log_variance = nn.Linear(state_dim, shared_dim)     # log s_A^2 = W f_A + b
+        self.language_log_variance = nn.Linear(self.to_language_code.in_features, shared_dim)  # log s_L^2 = W f_L + b
+        self.action_log_variance = nn.Linear(self.to_action_code.in_features, shared_dim)      # log s_A^2 = W f_A + b
 
     @staticmethod
     def sample(mean: torch.Tensor, log_variance: torch.Tensor) -> torch.Tensor:
@@ -53,7 +52,7 @@ class PVAE(PRAE):
 
         Returns the word logits, the joints, the means mu_L, mu_A and the log-variances.
         """
-        f_language = self.language_encoder(tokens, token_lengths)
+        f_language = self.language_features(tokens, token_lengths)
         f_action = self.action_encoder(inputs, lengths)
         mean_l, mean_a = self.to_language_code(f_language), self.to_action_code(f_action)
         log_var_l, log_var_a = self.language_log_variance(f_language), self.action_log_variance(f_action)

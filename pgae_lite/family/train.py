@@ -7,14 +7,15 @@ step takes a batch of paired samples, and each autoencoder rebuilds its own moda
       + KL(mu_L, s_L) + KL(mu_A, s_A)                                   PVAE (w_bind = 2, on the means)
 
 PRAE reads one description per action (the first of the 8: its paper's one-to-one data); PVAE
-draws one of the 8 equivalent descriptions for each sample at each step, as its authors do.
+(and PVAE-BERT, PVAE with the pretrained encoder) draws one of the 8 equivalent descriptions for
+each sample at each step, as its authors do.
 The words' weights and the joints' MSE are PGAE's (:func:`pgae_lite.train.loss.pgae_loss`), and
 so are the optimiser, its schedule and the input noise of the ``book`` recipe (``recipe``).
 """
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import torch
 
@@ -29,7 +30,9 @@ from pgae_lite.train.loss import add_input_noise, lr_factor, pgae_loss
 from pgae_lite.util.storage import default_device, training_threads
 from pgae_lite.world.words import word_weights
 
-MODELS = {"PRAE": PRAE, "PVAE": PVAE}
+#: name -> (the model, what it changes in the ModelConfig). PVAE-BERT: PVAE reading descriptions through the
+#: pretrained encoder this package ships, frozen (Deviation from paper: PVAE-BERT fine-tunes BERT-base).
+MODELS = {"PRAE": (PRAE, {}), "PVAE": (PVAE, {}), "PVAE-BERT": (PVAE, {"language_encoder": "pretrained"})}
 
 
 @dataclass
@@ -59,7 +62,7 @@ def family_loss(model: PRAE, batch, weights: torch.Tensor) -> tuple[torch.Tensor
 
 def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None = None,
                  recipe: TrainConfig | None = None, device: str | None = None) -> FamilyTrained:
-    """Train ``name`` (``"PRAE"`` or ``"PVAE"``) on the training split of ``dataset``."""
+    """Train ``name`` (``"PRAE"``, ``"PVAE"`` or ``"PVAE-BERT"``) on the training split of ``dataset``."""
     if name not in MODELS:
         raise ValueError(f"unknown family model {name!r}; the options are: {', '.join(MODELS)}")
     recipe, device = recipe or TrainConfig(), torch.device(device or default_device())
@@ -67,7 +70,8 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
     normaliser = Normaliser.fit(train_set, recipe.vision_scaling)
     with training_threads(device):
         torch.manual_seed(recipe.seed)
-        model = MODELS[name](model_cfg or ModelConfig()).to(device)
+        make, changes = MODELS[name]
+        model = make(replace(model_cfg or ModelConfig(), **changes)).to(device)
         data = normaliser.tensors(train_set, device)
         weights = word_weights().to(device)
         gen = torch.Generator().manual_seed(recipe.seed)
@@ -78,7 +82,7 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
             model.train()
             terms = []
             for index in torch.randperm(n, generator=gen).split(recipe.batch_size):
-                alternative = (torch.randint(0, 8, (len(index),), generator=gen) if name == "PVAE"
+                alternative = (torch.randint(0, 8, (len(index),), generator=gen) if make is PVAE
                                else torch.zeros(len(index), dtype=torch.long))      # PRAE: one description
                 batch = make_batch(data, index, signal_ids("repeat both", len(index)), alternative)
                 batch.action_input = add_input_noise(batch.action_input, recipe.input_noise,

@@ -14,6 +14,9 @@ from dataclasses import dataclass
 LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
 CELLS = ("lstm", "peephole")
 JOINT_FEEDBACKS = ("start", "predicted")
+#: What joins the two modalities into h: PGAE's Gated Multimodal Unit, or PTAE's crossmodal transformer
+#: (the words and signal attend to the action frames; pgae_lite.model.ptae).
+BOTTLENECKS = ("gmu", "crossmodal-transformer")
 
 
 def _whole(name: str, value, low: int, meaning: str = "") -> None:
@@ -56,6 +59,17 @@ class ModelConfig:
     # (plan.PlanHead; 0 = none, the paper's). It makes h carry which cube the words mean in this scene, which
     # the recorded frames otherwise tell the decoder: without it the closed loop mostly moves the other cube.
     plan_keyframes: int = 10
+    # "gmu" = PGAE; "crossmodal-transformer" = PTAE (model/ptae.py): the tokens and the frames enter one
+    # transformer layer of ``heads`` heads and a feed-forward of ``feedforward`` units, whose width is
+    # ``hidden``. The book's PTAE is 128 wide (config.TRAININGS); PTAE's authors: 4 heads, 256, 1024, 0.25.
+    bottleneck: str = "gmu"
+    heads: int = 4
+    # Deviation from paper: a feed-forward of 512 (PTAE: 1024), half the time, no dropout (PTAE: 0.25), and
+    # the frames read with their positions (PTAE: none). With dropout 0.25 repeat language stayed near 29%,
+    # and without positions describe near 27%: push and pull visit the same poses in opposite orders (A2).
+    feedforward: int = 512
+    dropout: float = 0.0
+    frame_positions: bool = True
 
     def __post_init__(self):
         for name in ("units", "layers", "hidden"):
@@ -69,6 +83,21 @@ class ModelConfig:
             raise ValueError(f"gmu_norm must be True or False; got {self.gmu_norm!r}")
         _whole("plan_keyframes", self.plan_keyframes, 0, " (0 = no plan head, the paper's)")
         _whole("time_stride", self.time_stride, 1, " (1 = every step, the paper's)")
+        if self.bottleneck not in BOTTLENECKS:
+            raise ValueError(f"unknown bottleneck {self.bottleneck!r}; the options are: {', '.join(BOTTLENECKS)}")
+        _whole("heads", self.heads, 1)
+        _whole("feedforward", self.feedforward, 1)
+        if isinstance(self.dropout, bool) or not isinstance(self.dropout, (int, float)) or not 0 <= self.dropout < 1:
+            raise ValueError(f"ModelConfig dropout must be a number in [0, 1); got {self.dropout!r}")
+        if not isinstance(self.frame_positions, bool):
+            raise ValueError(f"frame_positions must be True or False; got {self.frame_positions!r}")
+        if self.bottleneck == "crossmodal-transformer":
+            if self.hidden % self.heads:
+                raise ValueError(f"the crossmodal transformer splits its width (hidden={self.hidden}) among "
+                                 f"{self.heads} heads: hidden must be a multiple of heads")
+            if self.language_encoder != "lstm":
+                raise ValueError(f"the crossmodal transformer reads the words as tokens itself; "
+                                 f"language_encoder={self.language_encoder!r} needs bottleneck='gmu'")
         if self.language_encoder not in LANGUAGE_ENCODERS:
             raise ValueError(f"unknown language_encoder {self.language_encoder!r}; "
                              f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
@@ -83,4 +112,4 @@ class ModelConfig:
         return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
 
-__all__ = ["CELLS", "JOINT_FEEDBACKS", "LANGUAGE_ENCODERS", "ModelConfig"]
+__all__ = ["BOTTLENECKS", "CELLS", "JOINT_FEEDBACKS", "LANGUAGE_ENCODERS", "ModelConfig"]

@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from pgae_lite.bert.pretrained import model_source
-from pgae_lite.config import ROWS, Profile, get_profile
+from pgae_lite.config import EVERY_ROW, ROWS, Profile, get_profile
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate import PAPER_TABLE, Predictions, format_table
 from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
@@ -64,15 +64,15 @@ def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
     if isinstance(rows, str):
         rows = list(ROWS) if rows.strip().lower() == "all" else rows.split(",")
     if not rows:
-        raise ArgumentError(f"rows is empty; the rows are: {', '.join(ROWS)} or 'all'")
-    by_lower = {r.lower(): r for r in ROWS}
+        raise ArgumentError(f"rows is empty; the rows are: {', '.join(EVERY_ROW)} or 'all'")
+    by_lower = {r.lower(): r for r in EVERY_ROW}
     out = []
     for r in rows:
         name = by_lower.get(r.strip().lower()) if isinstance(r, str) else None
         if name is None:
             shown = r.strip() if isinstance(r, str) else r
             raise ArgumentError(f"unknown row {shown!r}; the rows are: "
-                                f"{', '.join(ROWS)} (or 'all')")
+                                f"{', '.join(EVERY_ROW)} (or 'all': Table 1's)")
         if name not in out:
             out.append(name)
     return out
@@ -179,8 +179,8 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
     dataset.split("train"), dataset.split("test")    # both needed: refused now, not after the trainings
     make_folder(out)                 # a file in the way, or no permission: one sentence
     source = None if original_data is None else str(Path(original_data).resolve())
-    trainings = list(dict.fromkeys(ROWS[r][0] for r in rows))
-    units = [(source, profile, t, seed, [r for r in rows if ROWS[r][0] == t], str(Path(out).resolve()), device,
+    trainings = list(dict.fromkeys(EVERY_ROW[r][0] for r in rows))
+    units = [(source, profile, t, seed, [r for r in rows if EVERY_ROW[r][0] == t], str(Path(out).resolve()), device,
               pretrained_model) for t in trainings for seed in seeds]
     if _as_sweep(len(units), device, workers, scheduler):
         done = run_sweep(table1_unit, units, workers=min(workers or os.cpu_count() or 1, len(units)),
@@ -190,8 +190,9 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
         done = [table1_unit(*unit, progress=progress) for unit in units]
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:
-        report["rows"][row] = {"training": ROWS[row][0], "paper": {
-            s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE[row].items()}, "seeds": {}}
+        report["rows"][row] = {"training": EVERY_ROW[row][0], "paper": {   # None: not a row of the paper's Table 1
+            s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE[row].items()} if row in ROWS else None,
+            "seeds": {}}
     for unit in done:
         prof = unit_profile(profile, unit["training"], unit["seed"], pretrained_model)
         folder = out / f"{unit['training']}-seed{unit['seed']}"
@@ -205,7 +206,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
     for row in rows:
         mean, std = summarise([report["rows"][row]["seeds"][str(s)] for s in seeds])
         report["rows"][row] |= {"mean": mean, "std": std}
-    first = next(u for u in done if u["training"] == ROWS[rows[0]][0] and u["seed"] == seeds[0])
+    first = next(u for u in done if u["training"] == EVERY_ROW[rows[0]][0] and u["seed"] == seeds[0])
     save_predictions(out / "predictions.npz", first["predictions"][rows[0]])
     return report
 
@@ -254,7 +255,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
                "wall_seconds": time.perf_counter() - t0}
     nonfinite = write_results(out / "results.json", report)
     print(format_table({f"{r} (ours)": report["rows"][r]["mean"] for r in rows},
-                       {f"{r} (ours)": r for r in rows},
+                       {f"{r} (ours)": r for r in rows if r in ROWS},
                        std={f"{r} (ours)": report["rows"][r]["std"] for r in rows} if seeds > 1 else None))
     times = ", ".join(f"{t} {statistics.fmean(v['train_seconds'].values()):.0f} s"
                       for t, v in report["trainings"].items())

@@ -16,7 +16,7 @@ import platform
 from dataclasses import replace
 from pathlib import Path
 
-from pgae_lite.config import ROWS, Profile, training_profile
+from pgae_lite.config import EVERY_ROW, Profile, training_profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.evaluate import evaluate
 from pgae_lite.train.checkpoint import check_trained_on, training_split
@@ -68,7 +68,7 @@ def table1_unit(original_data: str | None, profile: Profile, training: str, seed
     trained = train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
     cells, predictions, self_results = {}, {}, None
     for row in rows:
-        opposite = ROWS[row][1]
+        opposite = EVERY_ROW[row][1]
         results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=opposite)
         if opposite:
             if self_results is None:

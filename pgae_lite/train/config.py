@@ -95,6 +95,10 @@ class TrainConfig:
     phrasing_words: str = "all"
     # Not in the paper: the signals whose samples read phrasings (of execute, repeat both, repeat language).
     phrasing_signals: tuple[str, ...] = PHRASING_SIGNALS
+    # Limited supervision (PTAE paper; train/supervision.py): a share in (0, 1] of the updates is paired
+    # (the PTAE authors' reading), or of the training samples, a fixed labelled subset. None: the recipe's draws.
+    paired_share: float | None = None
+    labelled_share: float | None = None
     seed: int = 0
     max_train_samples: int | None = None  # a subset of the training split (smoke tests)
     checkpoint_every: int = 25          # epochs between checkpoints
@@ -106,6 +110,11 @@ class TrainConfig:
         _number("weight_decay", self.weight_decay, 0)
         _number("opposite_prob", self.opposite_prob, 0, 1)
         _number("input_noise", self.input_noise, 0)
+        for name in ("paired_share", "labelled_share"):
+            _number(name, getattr(self, name), 0, 1, above=True, optional=True)
+        if self.paired_share is not None and self.labelled_share is not None:
+            raise ValueError("TrainConfig takes one reading of limited supervision: paired_share (a share of the "
+                             "updates) or labelled_share (a fixed share of the samples), not both")
         _number("joint_input_noise", self.joint_input_noise, 0, optional=True)
         for name in ("language_weight", "action_weight", "plan_weight"):   # α, β, γ: a negative one maximises
             _number(name, getattr(self, name), 0)

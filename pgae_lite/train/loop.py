@@ -26,9 +26,10 @@ from pgae_lite.bert.phrasing_bank import for_training
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.plan import plan_loss, plan_targets
-from pgae_lite.model.signals import EXECUTE, make_batch, sample_signals
+from pgae_lite.model.signals import EXECUTE, make_batch
 from pgae_lite.train.checkpoint import CHECKPOINT, check_trained_on, load_checkpoint, save_checkpoint, training_split
 from pgae_lite.train.loss import add_input_noise, lr_factor, parameter_groups, pgae_loss
+from pgae_lite.train.supervision import draw_signals, labelled_samples
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.util.storage import CheckpointMismatchError, default_device, folder_lock, training_threads
 from pgae_lite.world.words import SIGNALS, word_weights
@@ -60,6 +61,7 @@ class Run:
     lengths: torch.Tensor                # each sample's length, on the CPU (for the batches)
     plans: torch.Tensor | None           # each sample's plan target (model/plan.py), if the model has a head
     batches: int                         # per epoch
+    labelled: torch.Tensor | None = None  # which samples are labelled (TrainConfig.labelled_share), on the CPU
     epoch: int = 0
     history: list[dict] = field(default_factory=list)
     elapsed: float = 0.0
@@ -156,7 +158,8 @@ def _setup(train_set: PGAEDataset, normaliser: Normaliser, profile, device: torc
     gen = torch.Generator().manual_seed(cfg.seed)
     lengths = data["lengths"].cpu()
     batches = len(batch_indices(lengths, cfg.batch_size, torch.Generator(), cfg.length_batches))
-    return Run(model, optimiser, gen, data, lengths, plans, batches)
+    labelled = None if cfg.labelled_share is None else labelled_samples(len(lengths), cfg.labelled_share, cfg.seed)
+    return Run(model, optimiser, gen, data, lengths, plans, batches, labelled)
 
 
 def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) -> None:
@@ -192,9 +195,10 @@ def _epoch(run: Run, cfg, epoch: int, weights: torch.Tensor, bank, device: torch
         if not torch.isfinite(losses).all():
             _stop(losses, epoch, b, run.batches, batch.signal)
         sums += losses * len(index)
-        z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
-        gate_sum.index_add_(0, batch.signal, z)
-        gate_n.index_add_(0, batch.signal, torch.ones(len(index)))
+        if "gate" in out:                                # PGAE's GMU (PTAE has none)
+            z = out["gate"].detach().float().mean(1).cpu()   # float: also under autocast
+            gate_sum.index_add_(0, batch.signal, z)
+            gate_n.index_add_(0, batch.signal, torch.ones(len(index)))
     loss, lang, act = (sums / len(run.lengths)).tolist()
     gates = (gate_sum / gate_n.clamp(min=1)).tolist()
     run.history.append({"epoch": epoch + 1, "loss": loss, "language_loss": lang, "action_loss": act,
@@ -206,7 +210,7 @@ def _epoch(run: Run, cfg, epoch: int, weights: torch.Tensor, bank, device: torch
 def _batch(run: Run, cfg, index: torch.Tensor):
     """The batch of samples ``index``: a signal each, a description, a view, the input noise."""
     size = len(index)
-    signal = sample_signals(size, run.gen, cfg.signals_per_sample, cfg.signal_probs)
+    signal = draw_signals(size, run.gen, cfg, None if run.labelled is None else run.labelled[index])
     alternative = torch.randint(8, (size,), generator=run.gen)
     opposite = torch.rand(size, generator=run.gen) < cfg.opposite_prob
     opposite &= signal != EXECUTE  # execute shows no action to the encoder

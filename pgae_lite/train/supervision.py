@@ -1,0 +1,63 @@
+"""Limited supervision: only some training steps pair an action with its description (PTAE paper, Sec. 4).
+
+A signal that reads one modality and writes the other (describe, execute) or both (repeat
+both) needs the pair; repeat action and repeat language need one modality only, so they
+learn from unpaired data. PTAE's authors ask how the models fare when few training steps
+are paired, and their code reads "x% supervised" as a share of *updates*: each batch is
+paired with probability x, while the loader reshuffles every epoch, so every sample is seen
+paired now and then. A fixed labelled subset of x% of the *samples* is the other reading::
+
+    | TrainConfig         | a paired step                     | the other steps                     |
+    |---------------------|-----------------------------------|-------------------------------------|
+    | paired_share = x    | a batch, with probability x       | the batch: repeat action / language |
+    | labelled_share = x  | a sample of the fixed x% subset   | the other samples: the same two     |
+    | both None (default) | every sample draws from signal_probs (7/9 of the draws paired)          |
+
+Within each kind a signal keeps its weight in ``TrainConfig.signal_probs``: describe 3/7,
+execute 3/7, repeat both 1/7 when paired; repeat action and repeat language 1/2 each otherwise.
+"""
+from __future__ import annotations
+
+import torch
+
+from pgae_lite.model.signals import DESCRIBE, EXECUTE, REPEAT_ACTION, REPEAT_BOTH, REPEAT_LANGUAGE, sample_signals
+
+PAIRED = (DESCRIBE, EXECUTE, REPEAT_BOTH)           # need the action and its description together
+UNIMODAL = (REPEAT_ACTION, REPEAT_LANGUAGE)          # need one of them only
+
+
+def restricted(probs: tuple[float, ...], keep: tuple[int, ...]) -> tuple[float, ...]:
+    """``probs`` with every signal outside ``keep`` set to 0, renormalised to sum to 1."""
+    kept = [q if i in keep else 0.0 for i, q in enumerate(probs)]
+    total = sum(kept)
+    if total <= 0:
+        raise ValueError(f"signal_probs give no weight to any of the signals {keep}; "
+                         "limited supervision needs both paired and unimodal signals")
+    return tuple(q / total for q in kept)
+
+
+def labelled_samples(count: int, share: float, seed: int) -> torch.Tensor:
+    """Which of ``count`` training samples are labelled (paired), (count,) bool: round(share · count) of
+    them (at least 1), drawn once from ``seed`` with a generator of their own."""
+    chosen = torch.randperm(count, generator=torch.Generator().manual_seed(seed))[:max(1, round(share * count))]
+    return torch.zeros(count, dtype=torch.bool).index_fill_(0, chosen, True)
+
+
+def draw_signals(size: int, gen: torch.Generator, cfg, labelled: torch.Tensor | None = None) -> torch.Tensor:
+    """The signals of one batch of ``size`` samples under ``cfg`` (a TrainConfig), (size,).
+
+    ``labelled`` (size,) bool: which of the batch's samples are in the labelled subset
+    (with ``cfg.labelled_share``). With neither share set, exactly the recipe's draws.
+    """
+    if cfg.paired_share is not None:                        # a share of the updates is paired
+        paired = torch.rand(1, generator=gen).item() < cfg.paired_share
+        probs = restricted(cfg.signal_probs, PAIRED if paired else UNIMODAL)
+        return sample_signals(size, gen, cfg.signals_per_sample, probs)
+    signals = sample_signals(size, gen, cfg.signals_per_sample, cfg.signal_probs)
+    if cfg.labelled_share is None:
+        return signals
+    unimodal = sample_signals(size, gen, cfg.signals_per_sample, restricted(cfg.signal_probs, UNIMODAL))
+    return torch.where(labelled, signals, unimodal)         # an unlabelled sample: one modality at a time
+
+
+__all__ = ["PAIRED", "UNIMODAL", "draw_signals", "labelled_samples", "restricted"]
