@@ -10,4 +10,5 @@
 - ``results``     the committed result files, read and quoted by the book and the README
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect
 - ``opposite_scale`` chapter 06's ablation: the two-view model under three scalings
+- ``incongruent`` the family's experiment: which modality a model follows when action and words disagree
 """
