@@ -316,3 +316,23 @@ def test_checks_leave_the_global_random_state_alone_and_repeat_exactly():
     check_gmu(MyGMU), check_peephole_step(peephole_step)
     assert torch.equal(torch.rand(3), expected)
     assert str(check_bottleneck(ConcatBottleneck)) == first
+
+
+# ------------------------------------------------------------------ chapter 09: the binding loss
+def test_check_binding_loss_passes_the_equation_and_names_each_known_mistake():
+    from pgae_lite.exercises import check_binding_loss
+    from pgae_lite.exercises.family import MISTAKES, _variant
+
+    def mine(z_language, z_action, margin):
+        d = torch.cdist(z_action, z_language)
+        b, own = len(d), d.diagonal()
+        push = [max(0.0, margin + own[j] - d[i, j]) + max(0.0, margin + own[i] - d[i, j])
+                for i in range(b) for j in range(b) if i != j]
+        return own.mean() + sum(push) / b ** 2
+
+    assert check_binding_loss(mine)
+    for mistake, switches in MISTAKES.items():
+        result = check_binding_loss(lambda zl, za, m, s=switches: _variant(zl, za, m, **s))
+        assert not result and mistake in str(result)
+    broken = check_binding_loss(lambda zl, za, m: 1 / 0)
+    assert not broken and "ZeroDivisionError" in str(broken)

@@ -240,3 +240,39 @@ def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(t
     assert tokens_to_text(x["tokens"][0]).startswith("repeat both ")
     expected = model.to_language_code(model.language_encoder.encode_texts([tokens_to_text(r) for r in x["tokens"]]))
     torch.testing.assert_close(model.language_code(x["tokens"], x["token_lengths"]), expected, atol=1e-5, rtol=1e-4)
+
+
+# ------------------------------------------------------------------ the chapter's models and tables
+def test_family_models_trains_the_chapters_three_and_ptae_is_cached():
+    from pgae_lite.family.pvae import PVAE
+    from pgae_lite.family.prae import PRAE
+    from pgae_lite.model.ptae import PTAE
+    from pgae_lite.runs.family_models import family_models
+
+    models = family_models("smoke", seed=0, device="cpu", progress=False, workers=1)
+    assert set(models) == {"PRAE-8", "PVAE", "PTAE"}
+    assert type(models["PRAE-8"].model) is PRAE and isinstance(models["PVAE"].model, PVAE)
+    assert isinstance(models["PTAE"].model, PTAE)
+    again = family_models("smoke", seed=0, device="cpu", progress=False, workers=1)
+    assert again["PRAE-8"].history == models["PRAE-8"].history          # seeded
+    first, second = models["PTAE"].model.state_dict(), again["PTAE"].model.state_dict()
+    assert all(torch.equal(first[k], second[k]) for k in first)         # PTAE: the cached model
+
+
+def test_the_family_table_marks_na_and_gives_median_and_range(tmp_path, monkeypatch):
+    import json
+
+    from pgae_lite.runs.family_table import family_frame
+
+    stats = {"median": 99.5, "min": 98.0, "max": 100.0}
+    configured = {s: {"accuracy": stats if s in ("describe", "repeat language") else None,
+                      "nrmse": None if s in ("describe", "repeat language") else stats}
+                  for s in ("describe", "repeat language", "execute", "repeat action")}
+    rows = {"PVAE": {"stats": configured, "train_seconds": [10.0, 30.0, 20.0], "parameters": 659638}}
+    (tmp_path / "family-ours.json").write_text(json.dumps({"benchmark": "family", "data": {"rows": rows}}))
+    monkeypatch.setenv("PGAE_LITE_RESULTS", str(tmp_path))
+    frame = family_frame("ours")
+    assert frame.loc["PVAE", ("describe", "words %")] == "99.50 [98.00, 100.00]"
+    assert frame.loc["PVAE", ("describe", "nRMSE %")] == "N.A."
+    assert frame.loc["PVAE", ("execute", "words %")] == "N.A."
+    assert frame.loc["PVAE", ("", "time (s)")] == "20" and frame.loc["PVAE", ("", "parameters")] == "659,638"

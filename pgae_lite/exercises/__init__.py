@@ -5,16 +5,18 @@ Each check runs a student's code next to the reference on seeded random inputs a
 much it did not, with a hint tied to the paper's equation), truthy only when everything matched
 (``assert check_gmu(MyGMU)``).
 A wrong answer never raises. Paper, Sec. 3: the LSTM step, the GMU or a replacement, the signals;
-Sec. 4: the vocabulary, and our simulator's cube colours.
+Sec. 4: the vocabulary, and our simulator's cube colours; Sec. 2: the binding loss of PGAE's predecessors.
 
 - ``result``  :class:`~pgae_lite.exercises.result.CheckResult` and how a check runs and compares student code
 - ``world``   chapters 01-03: ``check_vocabulary``, ``check_colour``; the guided project
               "Teach NICO a new colour": ``check_new_colour``
 - ``model``   chapters 04-05: ``check_peephole_step``, ``check_lstm_step``, ``check_gmu``,
               ``check_bottleneck``, ``check_signal_probs``
+- ``family``  chapter 09: ``check_binding_loss``
 
 Every check is importable from here, e.g. ``from pgae_lite.exercises import check_gmu``.
 """
+from pgae_lite.exercises.family import check_binding_loss
 from pgae_lite.exercises.model import (check_bottleneck, check_gmu, check_lstm_step, check_peephole_step,
                                       check_signal_probs)
 from pgae_lite.exercises.result import CheckResult
@@ -22,4 +24,4 @@ from pgae_lite.exercises.world import check_colour, check_new_colour, check_voca
 
 __all__ = ["CheckResult", "check_vocabulary", "check_colour", "check_new_colour",
            "check_peephole_step", "check_lstm_step", "check_gmu",
-           "check_bottleneck", "check_signal_probs"]
+           "check_bottleneck", "check_signal_probs", "check_binding_loss"]

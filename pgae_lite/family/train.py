@@ -61,8 +61,14 @@ def family_loss(model: PRAE, batch, weights: torch.Tensor) -> tuple[torch.Tensor
 
 
 def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None = None,
-                 recipe: TrainConfig | None = None, device: str | None = None) -> FamilyTrained:
-    """Train ``name`` (``"PRAE"``, ``"PVAE"`` or ``"PVAE-BERT"``) on the training split of ``dataset``."""
+                 recipe: TrainConfig | None = None, device: str | None = None,
+                 all_descriptions: bool | None = None) -> FamilyTrained:
+    """Train ``name`` (``"PRAE"``, ``"PVAE"`` or ``"PVAE-BERT"``) on the training split of ``dataset``.
+
+    ``all_descriptions``: whether each step draws one of the 8 descriptions (True) or reads the first
+    (False); None: the model's own (PRAE the first, PVAE all 8). PRAE with True is the one-to-many
+    experiment: a deterministic code for 8 descriptions of one action.
+    """
     if name not in MODELS:
         raise ValueError(f"unknown family model {name!r}; the options are: {', '.join(MODELS)}")
     recipe, device = recipe or TrainConfig(), torch.device(device or default_device())
@@ -71,6 +77,7 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
     with training_threads(device):
         torch.manual_seed(recipe.seed)
         make, changes = MODELS[name]
+        draw = make is PVAE if all_descriptions is None else all_descriptions
         model = make(replace(model_cfg or ModelConfig(), **changes)).to(device)
         data = normaliser.tensors(train_set, device)
         weights = word_weights().to(device)
@@ -82,7 +89,7 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
             model.train()
             terms = []
             for index in torch.randperm(n, generator=gen).split(recipe.batch_size):
-                alternative = (torch.randint(0, 8, (len(index),), generator=gen) if make is PVAE
+                alternative = (torch.randint(0, 8, (len(index),), generator=gen) if draw
                                else torch.zeros(len(index), dtype=torch.long))      # PRAE: one description
                 batch = make_batch(data, index, signal_ids("repeat both", len(index)), alternative)
                 batch.action_input = add_input_noise(batch.action_input, recipe.input_noise,

@@ -10,5 +10,7 @@
 - ``results``     the committed result files, read and quoted by the book and the README
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect
 - ``opposite_scale`` chapter 06's ablation: the two-view model under three scalings
+- ``family_models`` chapter 09's own PRAE, PVAE and PTAE, trained side by side
+- ``family_table`` the family's result files as tables (chapter 09, A2)
 - ``incongruent`` the family's experiment: which modality a model follows when action and words disagree
 """

@@ -1,0 +1,62 @@
+"""The family's committed result files as tables: chapter 09 and the results page (A2) show them.
+
+PGAE paper, Sec. 2 and 4 (PRAE, PVAE, N.A.) and PTAE's experiments. Each reads a file that a
+benchmark wrote (:mod:`pgae_lite.runs.results`):
+
+- ``family-original`` / ``family-ours`` (``benchmarks/family.py``): :func:`family_frame`;
+- ``limited_supervision`` (``benchmarks/limited_supervision.py``): :func:`limited_frame`;
+- ``incongruent`` (``benchmarks/incongruent.py``): :func:`conflict_frames`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from pgae_lite.runs import results
+from pgae_lite.world.words import TEST_SIGNALS
+
+MEASURES = (("words %", "accuracy", ".2f"), ("nRMSE %", "nrmse", ".3f"))
+
+
+def cell_text(stats: dict | None, fmt: str) -> str:
+    """A cell's median with the worst and best seed, ``"N.A."`` where the model cannot produce it."""
+    if stats is None:
+        return "N.A."
+    return f"{stats['median']:{fmt}} [{stats['min']:{fmt}}, {stats['max']:{fmt}}]"
+
+
+def family_frame(source: str) -> pd.DataFrame:
+    """The family table on ``source`` (``"original"`` or ``"ours"``): a row per model, each task's words and
+    nRMSE, the median training time (s) and the trainable parameters."""
+    out = {}
+    for name, row in results.value(f"family-{source}", "rows").items():
+        line = {(signal, what): cell_text(row["stats"][signal][key], fmt)
+                for signal in TEST_SIGNALS for what, key, fmt in MEASURES}
+        line[("", "time (s)")] = f"{np.median(row['train_seconds']):.0f}"
+        line[("", "parameters")] = f"{row['parameters']:,}"
+        out[name] = line
+    return pd.DataFrame(out).T
+
+
+def limited_frame() -> pd.DataFrame:
+    """Limited supervision: a row per (model, reading, share); describe accuracy and execute nRMSE."""
+    rows = {(r["model"], r["reading"], f"{100 * r['share']:g}%"): {
+        "describe words %": cell_text(r["stats"]["describe"]["accuracy"], ".2f"),
+        "execute nRMSE %": cell_text(r["stats"]["execute"]["nrmse"], ".3f")}
+        for r in results.value("limited_supervision", "table")}
+    return pd.DataFrame(rows).T.rename_axis(["model", "supervised", "share"])
+
+
+def conflict_frames() -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Incongruent input: the language conflicts (describe, %) and the action conflicts (execute, nRMSE %),
+    a column per model and measure, a row per conflict (``none``: the congruent input), medians."""
+    medians = results.value("incongruent", "medians")
+    language = pd.DataFrame({(m, what): {kind: round(v[what], 2) for kind, v in c["language"].items()}
+                             for m, c in medians.items() for what in ("described right", "said the words read")})
+    action = pd.DataFrame({(m, what): {kind: round(v[what], 3) for kind, v in c["action"].items()}
+                           for m, c in medians.items() for what in ("nrmse to the described", "nrmse to the shown")})
+    return (language.rename_axis("language conflict (describe, %)"),
+            action.rename_axis("action conflict (execute, nRMSE %)"))
+
+
+__all__ = ["cell_text", "conflict_frames", "family_frame", "limited_frame"]
