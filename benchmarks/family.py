@@ -30,7 +30,7 @@ def run(row: str, seed: int, profile_name: str, original_data: str | None, model
     from pgae_lite.bert.encoders import build_pgae
     from pgae_lite.config import get_profile
     from pgae_lite.family.configured import evaluate_configured
-    from pgae_lite.family.train import train_family
+    from pgae_lite.family.train import family_recipe, train_family
     from pgae_lite.model.pgae import count_parameters
     from pgae_lite.runs.table1_unit import table1_unit, unit_profile, worker_dataset
 
@@ -38,7 +38,8 @@ def run(row: str, seed: int, profile_name: str, original_data: str | None, model
     profile = get_profile(profile_name, seed=seed)
     data = worker_dataset(original_data, profile, "cpu")
     if row in CONFIGURED:
-        trained = train_family(row, data, profile.model, profile.train, device="cpu")
+        recipe = family_recipe(row, profile.train, profile.name, len(data.split("train")))
+        trained = train_family(row, data, profile.model, recipe, device="cpu")
         cells, _ = evaluate_configured(trained.model, data, trained.normaliser)
         seconds, parameters = trained.seconds, count_parameters(trained.model)
     else:

@@ -276,3 +276,16 @@ def test_the_family_table_marks_na_and_gives_median_and_range(tmp_path, monkeypa
     assert frame.loc["PVAE", ("describe", "nRMSE %")] == "N.A."
     assert frame.loc["PVAE", ("execute", "words %")] == "N.A."
     assert frame.loc["PVAE", ("", "time (s)")] == "20" and frame.loc["PVAE", ("", "parameters")] == "659,638"
+
+
+def test_the_paper_profile_trains_each_family_model_as_its_authors_did():
+    from pgae_lite.config import get_profile
+    from pgae_lite.family.train import family_recipe
+
+    paper, book = get_profile("paper").train, get_profile("book").train
+    assert family_recipe("PRAE", book, "book", 864) is book                 # the book's recipe is everyone's
+    prae = family_recipe("PRAE", paper, "paper", 864)
+    assert (prae.batch_size, prae.lr, prae.epochs) == (50, 1e-3, round(20_000 * 50 / 864))
+    pvae = family_recipe("PVAE", paper, "paper", 864)
+    assert (pvae.batch_size, pvae.lr, pvae.epochs) == (100, 1e-4, round(15_000 * 100 / 864))
+    assert (pvae.weight_decay, pvae.schedule, pvae.clip) == (0.0, "constant", None)   # Adam, as the paper's

@@ -16,7 +16,7 @@ from __future__ import annotations
 import os
 
 from pgae_lite.config import TRAININGS, Profile, get_profile
-from pgae_lite.family.train import FamilyTrained, train_family
+from pgae_lite.family.train import FamilyTrained, family_recipe, train_family
 from pgae_lite.runs.pipeline import _finished, simulated_dataset, trained_pgae
 from pgae_lite.runs.sweep import run_sweep
 from pgae_lite.util.storage import default_device
@@ -32,7 +32,8 @@ def _unit(name: str, profile: Profile, seed: int, device: str | None = None) -> 
         return trained_pgae("PTAE", prof, seed, device, progress=False).seconds
     model, every = FAMILY_UNITS[name]
     data = simulated_dataset(prof, device, progress=False)
-    return train_family(model, data, prof.model, prof.train, device, all_descriptions=every)
+    recipe = family_recipe(model, prof.train, prof.name, len(data.split("train")))
+    return train_family(model, data, prof.model, recipe, device, all_descriptions=every)
 
 
 def family_models(profile: Profile | str | None = None, seed: int = 0, device: str | None = None,
