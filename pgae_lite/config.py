@@ -29,6 +29,10 @@ from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.patterns import pattern_number
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
+#: ModelConfig's options of PTAE's transformer, and TrainConfig's of limited supervision: a recipe's dict
+#: (Profile.to_dict) leaves them out where they are unused, so the models cached and checkpointed before
+#: they existed keep their digests and their resume (a missing option reads as its default).
+TRANSFORMER_OPTIONS = ("bottleneck", "heads", "feedforward", "dropout", "frame_positions")
 PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
 
 
@@ -62,8 +66,14 @@ class Profile:
         ``recipe_version`` (:data:`~pgae_lite.train.config.RECIPE_VERSION`) says which meaning
         of these options a checkpoint was trained with.
         """
-        return {"name": self.name, "recipe_version": RECIPE_VERSION,
-                "model": asdict(self.model), "train": asdict(self.train)}
+        model, train = asdict(self.model), asdict(self.train)
+        if model["bottleneck"] == "gmu":        # the transformer's settings mean nothing to a GMU
+            for key in TRANSFORMER_OPTIONS:
+                model.pop(key)
+        for key in ("paired_share", "labelled_share"):
+            if train[key] is None:              # full supervision: the recipe as it was
+                train.pop(key)
+        return {"name": self.name, "recipe_version": RECIPE_VERSION, "model": model, "train": train}
 
 
 # --------------------------------------------------------------------------- the recipes

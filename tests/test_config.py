@@ -114,3 +114,18 @@ def test_a_checkpoint_of_another_recipe_version_is_refused():
         saved_model_config(old, "x.pt")
     with pytest.raises(CheckpointMismatchError, match="recipe version 1;"):
         saved_model_config({**recipe, "recipe_version": 1}, "x.pt")
+
+
+def test_a_recipe_leaves_out_the_options_it_does_not_use_so_cached_models_keep_their_keys():
+    """PTAE's transformer and limited supervision came after models were cached: PGAE's recipe dict is as before."""
+    from pgae_lite.config import TRANSFORMER_OPTIONS, training_profile
+    from pgae_lite.train.config import saved_model_config
+
+    pgae = get_profile("book").to_dict()
+    assert not set(TRANSFORMER_OPTIONS) & set(pgae["model"])
+    assert not {"paired_share", "labelled_share"} & set(pgae["train"])
+    assert saved_model_config(pgae, "x") == get_profile("book").model           # a missing option: its default
+    ptae = training_profile(get_profile("book", paired_share=0.2), "PTAE")
+    saved = ptae.to_dict()
+    assert saved["model"]["bottleneck"] == "crossmodal-transformer" and saved["train"]["paired_share"] == 0.2
+    assert saved_model_config(saved, "x") == ptae.model
