@@ -176,6 +176,8 @@ def format_table(results: dict[str, dict[str, dict[str, float]]], paper_rows: di
                                 "them)")
 
     def cell(name: str, signal: str, key: str, fmt: str) -> str:
+        if results[name][signal][key] is None:                   # a configured model's N.A. (PRAE, PVAE)
+            return f"{'N.A.':>17s}"
         value = format(results[name][signal][key], fmt)
         if std is not None:
             value += " ± " + format(std[name][signal][key], fmt)
@@ -192,6 +194,7 @@ def format_table(results: dict[str, dict[str, dict[str, float]]], paper_rows: di
     for name, res in results.items():
         if std is None:
             lines.append(f"{name:26s}" + "".join(
+                f"{'N.A.':>17s}" if res[s]['nrmse'] is None else
                 f"{res[s]['nrmse']:9.3f} [{res[s]['nrmse_padded']:5.3f}]" for s in TEST_SIGNALS))
         else:
             lines.append(f"{name:26s}" + "".join(cell(name, s, "nrmse", ".3f") for s in TEST_SIGNALS))

@@ -289,3 +289,26 @@ def test_the_paper_profile_trains_each_family_model_as_its_authors_did():
     pvae = family_recipe("PVAE", paper, "paper", 864)
     assert (pvae.batch_size, pvae.lr, pvae.epochs) == (100, 1e-4, round(15_000 * 100 / 864))
     assert (pvae.weight_decay, pvae.schedule, pvae.clip) == (0.0, "constant", None)   # Adam, as the paper's
+
+
+def test_reproduce_takes_a_configured_row_writes_na_as_null_and_loads_its_model_again(original_data, tmp_path):
+    import json
+
+    import numpy as np
+
+    from pgae_lite.runs.reproduce import reproduce
+
+    args = dict(profile="smoke", rows="PVAE", epochs=1, out_dir=tmp_path, device="cpu", progress=False)
+    reproduce(original_data, **args)
+    report = json.loads((tmp_path / "results.json").read_text())
+    row = report["rows"]["PVAE"]
+    assert row["paper"] is None
+    assert row["mean"]["describe"]["nrmse"] is None and row["mean"]["execute"]["accuracy"] is None   # N.A.
+    assert isinstance(row["mean"]["describe"]["accuracy"], float) and isinstance(row["mean"]["execute"]["nrmse"], float)
+    with np.load(tmp_path / "predictions.npz") as predictions:
+        assert np.isnan(predictions["describe_joints"]).all()                  # no joints while describing
+        assert (predictions["execute_text"] == "").all()                       # no words while executing
+    saved = (tmp_path / "PVAE-seed0" / "family.pt").stat().st_mtime_ns
+    again = reproduce(original_data, **args)                                    # loaded, not trained again
+    assert (tmp_path / "PVAE-seed0" / "family.pt").stat().st_mtime_ns == saved
+    assert again["rows"]["PVAE"]["mean"] == report["rows"]["PVAE"]["mean"]

@@ -25,6 +25,7 @@ from pgae_lite.family.prae import PRAE, paired_inputs
 from pgae_lite.family.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.signals import make_batch, signal_ids
+from pgae_lite.train.checkpoint import training_split
 from pgae_lite.train.config import TrainConfig
 from pgae_lite.train.loss import add_input_noise, lr_factor, pgae_loss
 from pgae_lite.util.storage import default_device, training_threads
@@ -84,7 +85,7 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
     if name not in MODELS:
         raise ValueError(f"unknown family model {name!r}; the options are: {', '.join(MODELS)}")
     recipe, device = recipe or TrainConfig(), torch.device(device or default_device())
-    train_set = dataset.split("train")
+    train_set = training_split(dataset, recipe.max_train_samples)      # the training split (or its first samples)
     normaliser = Normaliser.fit(train_set, recipe.vision_scaling)
     with training_threads(device):
         torch.manual_seed(recipe.seed)

@@ -154,10 +154,13 @@ def save_predictions(path: Path, preds: dict[str, Predictions]) -> None:
         np.savez_compressed(f, **arrays)
 
 
-def summarise(per_seed: list[dict[str, dict[str, float]]]) -> tuple[dict, dict]:
-    """Mean and standard deviation (0 for one seed) of every cell over seeds."""
-    mean = {s: {c: statistics.fmean(r[s][c] for r in per_seed) for c in CELLS} for s in TEST_SIGNALS}
-    std = {s: {c: statistics.stdev([r[s][c] for r in per_seed]) if len(per_seed) > 1 else 0.0 for c in CELLS}
+def summarise(per_seed: list[dict[str, dict[str, float | None]]]) -> tuple[dict, dict]:
+    """Mean and standard deviation (0 for one seed) of every cell over seeds; None where a cell is N.A."""
+    def over(s: str, c: str, f) -> float | None:
+        values = [r[s][c] for r in per_seed]
+        return None if any(v is None for v in values) else f(values)
+    mean = {s: {c: over(s, c, statistics.fmean) for c in CELLS} for s in TEST_SIGNALS}
+    std = {s: {c: over(s, c, lambda v: statistics.stdev(v) if len(v) > 1 else 0.0) for c in CELLS}
            for s in TEST_SIGNALS}
     return mean, std
 
@@ -197,7 +200,8 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
         prof = unit_profile(profile, unit["training"], unit["seed"], pretrained_model)
         folder = out / f"{unit['training']}-seed{unit['seed']}"
         check_made_on(unit, dataset, prof, folder)    # trained elsewhere on other features: an error
-        info = report["trainings"].setdefault(unit["training"], {"profile": prof.to_dict(), "train_seconds": {}})
+        info = report["trainings"].setdefault(unit["training"], {"profile": unit.get("profile", prof.to_dict()),
+                                                                 "train_seconds": {}})
         info["train_seconds"][str(unit["seed"])] = unit["seconds"]
         for row, cells in unit["cells"].items():
             make_folder(folder)

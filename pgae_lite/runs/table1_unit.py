@@ -16,10 +16,11 @@ import platform
 from dataclasses import replace
 from pathlib import Path
 
-from pgae_lite.config import EVERY_ROW, Profile, training_profile
+from pgae_lite.config import CONFIGURED_ROWS, EVERY_ROW, Profile, training_profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.evaluate import evaluate
 from pgae_lite.train.checkpoint import check_trained_on, training_split
+from pgae_lite.runs.configured_unit import configured_profile, configured_unit
 from pgae_lite.runs.pipeline import simulated_dataset, train_when_free
 from pgae_lite.util.storage import cache_dir, config_digest
 
@@ -51,7 +52,10 @@ def remember_dataset(original_data: str | None, profile: Profile, dataset: PGAED
 
 
 def unit_profile(profile: Profile, training: str, seed: int, pretrained_model: str | None = None) -> Profile:
-    """The recipe of one unit: ``profile`` with the training's changes and the seed."""
+    """The recipe of one unit: ``profile`` with the training's changes and the seed (a configured row's:
+    :func:`~pgae_lite.runs.configured_unit.configured_profile`)."""
+    if training in CONFIGURED_ROWS:
+        return configured_profile(profile, training, seed)
     return training_profile(replace(profile, train=replace(profile.train, seed=seed)), training, pretrained_model)
 
 
@@ -64,6 +68,8 @@ def table1_unit(original_data: str | None, profile: Profile, training: str, seed
     Predictions}}, "normaliser": the statistics it was trained on, "made_on": host and cache}``.
     """
     dataset = worker_dataset(original_data, profile, device)
+    if training in CONFIGURED_ROWS:         # PRAE, PVAE, PVAE-BERT: measured per configuration, N.A. cells
+        return configured_unit(dataset, profile, training, seed, out, device)
     prof = unit_profile(profile, training, seed, pretrained_model)
     trained = train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
     cells, predictions, self_results = {}, {}, None
