@@ -50,23 +50,31 @@ def _load(path: Path, name: str, prof: Profile, fitted: dict, source: str) -> Fa
                          saved["seconds"])
 
 
+def trained_configured(path: Path, name: str, prof: Profile, dataset: PGAEDataset, device: str | None = None,
+                       all_descriptions: bool | None = None) -> FamilyTrained:
+    """``name`` trained with ``prof`` on ``dataset``: loaded from ``path`` if it was trained there with this
+    recipe on this data, else trained and saved there (``all_descriptions``: see ``train_family``; a
+    different value needs a different ``path``)."""
+    train_set = training_split(dataset, prof.train.max_train_samples)       # what train_family fits on
+    fitted = Normaliser.fit(train_set, prof.train.vision_scaling).state_dict()
+    trained = _load(path, name, prof, fitted, dataset.source)
+    if trained is None:
+        trained = train_family(name, dataset, prof.model, prof.train, device, all_descriptions)
+        save_torch({"name": name, "model": trained.model.state_dict(), "profile": prof.to_dict(),
+                    "normaliser": trained.normaliser.state_dict(), "history": trained.history,
+                    "seconds": trained.seconds}, path)
+    return trained
+
+
 def configured_unit(dataset: PGAEDataset, profile: Profile, name: str, seed: int, out: str,
                     device: str | None = None) -> dict:
     """Train (or load) ``name`` with ``seed`` into ``out/NAME-seedS``, measure its configured cells."""
     prof = configured_profile(profile, name, seed, len(dataset.split("train")))
-    train_set = training_split(dataset, prof.train.max_train_samples)       # what train_family fits on
-    fitted = Normaliser.fit(train_set, prof.train.vision_scaling).state_dict()
-    path = Path(out) / f"{name}-seed{seed}" / SAVED
-    trained = _load(path, name, prof, fitted, dataset.source)
-    if trained is None:
-        trained = train_family(name, dataset, prof.model, prof.train, device)
-        save_torch({"name": name, "model": trained.model.state_dict(), "profile": prof.to_dict(),
-                    "normaliser": trained.normaliser.state_dict(), "history": trained.history,
-                    "seconds": trained.seconds}, path)
+    trained = trained_configured(Path(out) / f"{name}-seed{seed}" / SAVED, name, prof, dataset, device)
     cells, predictions = evaluate_configured(trained.model, dataset, trained.normaliser)
     return {"training": name, "seed": seed, "seconds": trained.seconds, "cells": {name: cells},
             "profile": prof.to_dict(), "predictions": {name: predictions},
             "normaliser": trained.normaliser.state_dict(), "made_on": f"{platform.node()}, cache {cache_dir()}"}
 
 
-__all__ = ["SAVED", "configured_profile", "configured_unit"]
+__all__ = ["SAVED", "configured_profile", "configured_unit", "trained_configured"]
