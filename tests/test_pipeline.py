@@ -45,13 +45,13 @@ def test_several_models_train_side_by_side_and_then_load():
     import torch
 
     from pgae_lite.config import TRAININGS, training_profile
-    from pgae_lite.runs.pipeline import _finished, _model_folder, trained_pgae, trained_pgaes
+    from pgae_lite.runs.pipeline import is_trained, model_folder, trained_pgae, trained_pgaes
     from pgae_lite.runs.trainings import NO_PLAN
 
     for training in (TRAININGS["PGAE"], NO_PLAN):     # left by an earlier run of this test in the same cache
-        shutil.rmtree(_model_folder(training_profile(get_profile("smoke", seed=7), training), training.name),
+        shutil.rmtree(model_folder(training_profile(get_profile("smoke", seed=7), training), training.name),
                       ignore_errors=True)
-        assert not _finished(training, get_profile("smoke"), 7)
+        assert not is_trained(training, get_profile("smoke"), 7)
     models = trained_pgaes(["PGAE", NO_PLAN], "smoke", seed=7, device="cpu", progress=False, workers=2)
     assert set(models) == {"PGAE", "PGAE-no-plan"}
     assert models["PGAE"].model.plan_head is not None and models["PGAE-no-plan"].model.plan_head is None
@@ -71,7 +71,7 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
     from pgae_lite.config import training_profile
     from pgae_lite.runs import pipeline
 
-    folder = pipeline._model_folder(training_profile(get_profile("smoke", seed=7), "PGAE"), "PGAE")
+    folder = pipeline.model_folder(training_profile(get_profile("smoke", seed=7), "PGAE"), "PGAE")
     shutil.rmtree(folder, ignore_errors=True)        # not trained yet (a trained one loads without waiting)
     pipeline.simulated_dataset("smoke", "cpu", progress=False)     # recorded before the other run starts
     monkeypatch.setattr(pipeline, "BUSY_POLL_SECONDS", 0.1)
@@ -93,10 +93,10 @@ def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(mo
     from pgae_lite.util.storage import config_digest
 
     prof = training_profile(get_profile("smoke"), PHRASINGS)
-    before = pipeline._model_folder(prof, "PGAE-BERT-phrasings")
-    assert pipeline._model_folder(prof, "PGAE-BERT-phrasings") == before        # the same sentences, the same model
+    before = pipeline.model_folder(prof, "PGAE-BERT-phrasings")
+    assert pipeline.model_folder(prof, "PGAE-BERT-phrasings") == before        # the same sentences, the same model
     shorter = replace(phrase_lexicon.LEXICON, carriers=phrase_lexicon.LEXICON.carriers[:-1])
     monkeypatch.setattr(phrase_lexicon, "LEXICON", shorter)                      # one carrier sentence less
-    assert pipeline._model_folder(prof, "PGAE-BERT-phrasings") != before
+    assert pipeline.model_folder(prof, "PGAE-BERT-phrasings") != before
     plain = training_profile(get_profile("smoke"), "PGAE")                       # no phrasings: named as before
-    assert pipeline._model_folder(plain, "PGAE").name.endswith(f"-PGAE-{config_digest(plain.to_dict())}")
+    assert pipeline.model_folder(plain, "PGAE").name.endswith(f"-PGAE-{config_digest(plain.to_dict())}")

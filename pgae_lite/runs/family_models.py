@@ -20,7 +20,7 @@ from pathlib import Path
 from pgae_lite.config import TRAININGS, Profile, get_profile
 from pgae_lite.family.train import FamilyTrained
 from pgae_lite.runs.configured_unit import SAVED, configured_profile, trained_configured
-from pgae_lite.runs.pipeline import _finished, _model_folder, simulated_dataset, trained_pgae
+from pgae_lite.runs.pipeline import is_trained, model_folder, simulated_dataset, trained_pgae
 from pgae_lite.runs.sweep import run_sweep
 from pgae_lite.util.storage import default_device
 
@@ -32,7 +32,7 @@ def _saved_at(name: str, prof: Profile, seed: int, data) -> tuple[Profile, Path]
     """The recipe of a family unit and where its model is cached: beside the PGAEs, under the data's, the
     CAE's and the recipe's digests and the unit's own name (PRAE-8 is not PRAE)."""
     prof = configured_profile(prof, FAMILY_UNITS[name][0], seed, len(data.split("train")))
-    return prof, _model_folder(prof, name) / SAVED
+    return prof, model_folder(prof, name) / SAVED
 
 
 def _unit(name: str, profile: Profile, seed: int, device: str | None = None) -> FamilyTrained | float:
@@ -54,7 +54,7 @@ def family_models(profile: Profile | str | None = None, seed: int = 0, device: s
     prof = get_profile(profile)
     data = simulated_dataset(prof, device, progress)       # made once, before any worker reads it
     todo = [n for n in FAMILY_UNITS if not _saved_at(n, get_profile(prof, seed=seed), seed, data)[1].exists()]
-    todo += [] if _finished(TRAININGS["PTAE"], prof, seed) else ["PTAE"]
+    todo += [] if is_trained(TRAININGS["PTAE"], prof, seed) else ["PTAE"]
     cpu = torch.device(device or default_device()).type == "cpu"
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo) or 1))
     if todo and progress:

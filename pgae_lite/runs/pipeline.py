@@ -131,7 +131,7 @@ def cached_dataset(path: Path, make: Callable[[], PGAEDataset], configs: dict, s
     return dataset
 
 
-def _model_folder(prof: Profile, training: str) -> Path:
+def model_folder(prof: Profile, training: str) -> Path:
     """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
     (the recipe's holds its version) and, for a training on phrasings, the sentences' own."""
     name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
@@ -162,7 +162,7 @@ def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | Non
     base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
     dataset = _with_both_splits(simulated_dataset(base, device, progress))
     prof = training_profile(base, training)
-    folder = _model_folder(prof, training.name)
+    folder = model_folder(prof, training.name)
     while True:
         try:
             return train_when_free(dataset, prof, folder, device, progress, training.name, announce=progress)
@@ -224,7 +224,7 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
     trainings = [as_training(t) for t in trainings]
     prof = get_profile(profile)                                     # a name is resolved once, here
     cpu = torch.device(device or default_device()).type == "cpu"
-    todo = [t for t in {t.name: t for t in trainings}.values() if not _finished(t, prof, seed)]
+    todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
         _with_both_splits(simulated_dataset(prof, device, progress))   # made once, before the workers read it
@@ -239,12 +239,12 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
     return {t.name: trained_pgae(t, prof, seed, device, progress) for t in trainings}
 
 
-def _finished(training: Training, profile: Profile, seed: int) -> bool:
+def is_trained(training: Training, profile: Profile, seed: int) -> bool:
     """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
     from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 
     prof = training_profile(get_profile(profile, seed=seed), training)
-    folder = _model_folder(prof, training.name)
+    folder = model_folder(prof, training.name)
     try:
         return load_checkpoint(folder / CHECKPOINT)["epoch"] >= prof.train.epochs
     except Exception:  # noqa: BLE001 -- missing or damaged: trained_pgae trains (again)
@@ -252,4 +252,5 @@ def _finished(training: Training, profile: Profile, seed: int) -> bool:
 
 
 __all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "train_when_free", "cae_path",
+           "model_folder", "is_trained",
            "cached_cae", "cached_dataset", "made_otherwise"]
