@@ -12,7 +12,7 @@ and the book's reference page, ``book/api.md``, to one another):
 - ``train``      training PGAE: its settings, loss, loop and checkpoints (chapter 04)
 - ``evaluate``   Table 1: description accuracy and joint nRMSE (chapter 04)
 - ``bert``       PGAE-BERT's pretrained language encoder and the free-form language on it (chapter 05)
-- ``family``     PGAE's predecessors PRAE, PVAE and PVAE-BERT, configured per direction (PTAE is in ``model``)
+- ``family``     PGAE's predecessors PRAE, PVAE and PVAE-BERT(-tuned), configured per direction (PTAE is in ``model``)
 - ``config``     the recipes: the profiles smoke / book / paper and Table 1's trainings
 - ``runs``       the cached pipeline, side trainings, Table 1 over seeds, the results files (chapters 02-08, A1-A3)
 - ``robot``      the model drives the simulated robot: closed loop, instructions, playground (chapters 07, 08)

@@ -26,7 +26,7 @@ ORIGINAL_DATA_ENV = "PGAE_ORIGINAL_DATA"
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")
 ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
-FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PTAE")
+FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned", "PTAE")
 
 
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:

@@ -198,9 +198,10 @@ ROWS: dict[str, tuple[str, bool]] = {
 #: The family's rows beside Table 1's (not in PGAE's Table 1; benchmarks/family.py's table): ``reproduce
 #: --rows`` takes them by name, ``--rows all`` means Table 1's.
 FAMILY_ROWS: dict[str, tuple[str, bool]] = {"PRAE": ("PRAE", False), "PVAE": ("PVAE", False),
-                                             "PVAE-BERT": ("PVAE-BERT", False), "PTAE": ("PTAE", False)}
+                                             "PVAE-BERT": ("PVAE-BERT", False),
+                                             "PVAE-BERT-tuned": ("PVAE-BERT-tuned", False), "PTAE": ("PTAE", False)}
 #: The family's rows configured per direction: trained by pgae_lite.family.train, not as a Training.
-CONFIGURED_ROWS = ("PRAE", "PVAE", "PVAE-BERT")
+CONFIGURED_ROWS = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned")
 EVERY_ROW: dict[str, tuple[str, bool]] = {**ROWS, **FAMILY_ROWS}
 
 

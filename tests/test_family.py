@@ -197,7 +197,7 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
 
 
 # ------------------------------------------------------------------ training the family
-@pytest.mark.parametrize("name", ["PRAE", "PVAE", "PVAE-BERT"])
+@pytest.mark.parametrize("name", ["PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned"])
 def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
     from pgae_lite.family.train import train_family
     from pgae_lite.model.config import ModelConfig
@@ -216,7 +216,8 @@ def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
 def test_an_unknown_family_model_is_refused(toy_short):
     from pgae_lite.family.train import train_family
 
-    with pytest.raises(ValueError, match="unknown family model 'PTAE'; the options are: PRAE, PVAE, PVAE-BERT"):
+    options = "PRAE, PVAE, PVAE-BERT, PVAE-BERT-tuned"
+    with pytest.raises(ValueError, match=f"unknown family model 'PTAE'; the options are: {options}"):
         train_family("PTAE", toy_short)
 
 
@@ -240,6 +241,21 @@ def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(t
     assert tokens_to_text(x["tokens"][0]).startswith("repeat both ")
     expected = model.to_language_code(model.language_encoder.encode_texts([tokens_to_text(r) for r in x["tokens"]]))
     torch.testing.assert_close(model.language_code(x["tokens"], x["token_lengths"]), expected, atol=1e-5, rtol=1e-4)
+
+
+def test_pvae_bert_tuned_trains_its_top_layer_and_nothing_below(toy_short):
+    from pgae_lite.bert.tuned_encoder import TunedPretrainedEncoder
+    from pgae_lite.family.train import train_family
+    from pgae_lite.model.config import ModelConfig
+    from pgae_lite.train.config import TrainConfig
+
+    cfg, recipe = ModelConfig(units=16, time_stride=1), TrainConfig(epochs=2, batch_size=16)
+    untrained = TunedPretrainedEncoder()
+    trained = train_family("PVAE-BERT-tuned", toy_short, cfg, recipe, device="cpu").model
+    assert isinstance(trained.language_encoder, TunedPretrainedEncoder)
+    before, after = untrained.top.state_dict(), trained.language_encoder.top.state_dict()
+    assert any(not torch.equal(before[k], after[k]) for k in before)     # the top layer learned
+    assert not any(p.requires_grad for p in trained.language_encoder.transformer.model.parameters())
 
 
 # ------------------------------------------------------------------ the chapter's models and tables

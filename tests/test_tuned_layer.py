@@ -127,7 +127,7 @@ def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path, interr
 
 
 def test_clear_errors_and_the_keys_of_models_before():
-    with pytest.raises(ValueError, match="tuned_top_layer needs language_encoder='pretrained-attention'"):
+    with pytest.raises(ValueError, match="tuned_top_layer needs a pretrained language encoder"):
         ModelConfig(tuned_top_layer=True)
     with pytest.raises(ValueError, match="tuned_top_layer must be True or False; got 'yes'"):
         ModelConfig(language_encoder="pretrained-attention", tuned_top_layer="yes")

@@ -9,7 +9,8 @@ passes the encoder's builder in:
 
 - ``"lstm"``: PGAE's LSTM (:class:`~pgae_lite.model.pgae.LanguageEncoder`);
 - ``"pretrained"``: PGAE-BERT's frozen transformer, mean-pooled
-  (:class:`~pgae_lite.bert.pretrained.PretrainedLanguageEncoder`);
+  (:class:`~pgae_lite.bert.pretrained.PretrainedLanguageEncoder`); with ``tuned_top_layer``, its top
+  layer tuned on every input, PVAE-BERT's fine-tuning (:class:`~pgae_lite.bert.tuned_encoder.TunedPretrainedEncoder`);
 - ``"pretrained-attention"`` (not in the paper): the transformer read through a trained attention
   pooling, its top layer tuned for free text with ``tuned_top_layer``
   (:class:`~pgae_lite.bert.attention_pooling.AttentivePretrainedEncoder`).
@@ -20,6 +21,7 @@ from torch import nn
 
 from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder
+from pgae_lite.bert.tuned_encoder import TunedPretrainedEncoder
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.pgae import PGAE, LanguageEncoder
 from pgae_lite.model.ptae import PTAE
@@ -35,6 +37,8 @@ def build_language_encoder(cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON)
                          "use language_encoder='lstm' with a larger lexicon")
     if cfg.language_encoder == "pretrained-attention":
         return AttentivePretrainedEncoder(cfg.pretrained_model, tuned=cfg.tuned_top_layer)
+    if cfg.tuned_top_layer:
+        return TunedPretrainedEncoder(cfg.pretrained_model)
     return PretrainedLanguageEncoder(cfg.pretrained_model)
 
 

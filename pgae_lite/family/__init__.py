@@ -8,7 +8,7 @@ PGAE's successor PTAE is one model doing every task as PGAE does, trained by PGA
 - ``binding``     the binding loss that pulls paired action and description codes together
 - ``prae``        PRAE: two autoencoders bound by that loss, translating by their cross paths
 - ``pvae``        PVAE: PRAE with a variational bottleneck per modality (means, log-variances, KL)
-- ``train``       training PRAE, PVAE and PVAE-BERT (PVAE on the pretrained encoder): both autoencoders at
-                  once, bound by the binding loss
+- ``train``       training PRAE, PVAE and PVAE-BERT (PVAE on the pretrained encoder, frozen or with its top
+                  layer tuned): both autoencoders at once, bound by the binding loss
 - ``configured``  Table 1's cells of a model configured per direction, N.A. where it has no path
 """

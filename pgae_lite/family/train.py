@@ -10,7 +10,8 @@ PRAE reads one description per action (the first of the 8: its paper's one-to-on
 (and PVAE-BERT, PVAE with the pretrained encoder) draws one of the 8 equivalent descriptions for
 each sample at each step, as its authors do.
 The words' weights and the joints' MSE are PGAE's (:func:`pgae_lite.train.loss.pgae_loss`), and
-so are the optimiser, its schedule and the input noise of the ``book`` recipe (``recipe``).
+so are the optimiser, its schedule, the input noise and the batches of one length of the ``book``
+recipe (``recipe``; :func:`pgae_lite.train.loop.batch_indices`).
 """
 from __future__ import annotations
 
@@ -27,16 +28,20 @@ from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.train.checkpoint import training_split
 from pgae_lite.train.config import TrainConfig
-from pgae_lite.train.loss import add_input_noise, lr_factor, pgae_loss
+from pgae_lite.train.loop import batch_indices
+from pgae_lite.train.loss import add_input_noise, lr_factor, parameter_groups, pgae_loss
 from pgae_lite.util.storage import default_device, training_threads
 from pgae_lite.world.words import word_weights
 
 #: name -> (the model, what it changes in the ModelConfig). PVAE-BERT: PVAE reading descriptions through the
-#: pretrained encoder this package ships, frozen (Deviation from paper: PVAE-BERT fine-tunes BERT-base).
-MODELS = {"PRAE": (PRAE, {}), "PVAE": (PVAE, {}), "PVAE-BERT": (PVAE, {"language_encoder": "pretrained"})}
+#: pretrained encoder this package ships, frozen; PVAE-BERT-tuned: the same with the encoder's top layer tuned
+#: (bert/tuned_encoder.py). Deviation from paper: PVAE-BERT fine-tunes the whole of BERT-base.
+MODELS = {"PRAE": (PRAE, {}), "PVAE": (PVAE, {}), "PVAE-BERT": (PVAE, {"language_encoder": "pretrained"}),
+          "PVAE-BERT-tuned": (PVAE, {"language_encoder": "pretrained", "tuned_top_layer": True})}
 #: The authors' training of each (iterations, batch, Adam's rate), the ``paper`` profile's: PRAE's code 20,000
-#: iterations of 50 at 1e-3; PVAE's 15,000 of 100 at 1e-4; PVAE-BERT's 40,000 of 100 at 1e-4.
-AUTHORS_TRAINING = {"PRAE": (20_000, 50, 1e-3), "PVAE": (15_000, 100, 1e-4), "PVAE-BERT": (40_000, 100, 1e-4)}
+#: iterations of 50 at 1e-3; PVAE's 15,000 of 100 at 1e-4; PVAE-BERT's (either encoder) 40,000 of 100 at 1e-4.
+AUTHORS_TRAINING = {"PRAE": (20_000, 50, 1e-3), "PVAE": (15_000, 100, 1e-4), "PVAE-BERT": (40_000, 100, 1e-4),
+                    "PVAE-BERT-tuned": (40_000, 100, 1e-4)}
 
 
 def family_recipe(name: str, recipe: TrainConfig, profile_name: str, samples: int) -> TrainConfig:
@@ -76,7 +81,7 @@ def family_loss(model: PRAE, batch, weights: torch.Tensor) -> tuple[torch.Tensor
 def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None = None,
                  recipe: TrainConfig | None = None, device: str | None = None,
                  all_descriptions: bool | None = None) -> FamilyTrained:
-    """Train ``name`` (``"PRAE"``, ``"PVAE"`` or ``"PVAE-BERT"``) on the training split of ``dataset``.
+    """Train ``name`` (a key of :data:`MODELS`) on the training split of ``dataset``.
 
     ``all_descriptions``: whether each step draws one of the 8 descriptions (True) or reads the first
     (False); None: the model's own (PRAE the first, PVAE all 8). PRAE with True is the one-to-many
@@ -95,20 +100,23 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
         data = normaliser.tensors(train_set, device)
         weights = word_weights().to(device)
         gen = torch.Generator().manual_seed(recipe.seed)
-        optimiser = torch.optim.AdamW(model.parameters(), lr=recipe.lr, weight_decay=recipe.weight_decay)
-        n, history, step, t0 = len(train_set), [], 0, time.perf_counter()
-        steps = recipe.epochs * -(-n // recipe.batch_size)
+        fused = dict(fused=True) if device.type in ("cpu", "cuda") else {}   # one kernel, as PGAE's loop
+        optimiser = torch.optim.AdamW(parameter_groups(model), lr=recipe.lr, weight_decay=recipe.weight_decay,
+                                      **fused)
+        lengths, history, step, t0 = data["lengths"].cpu(), [], 0, time.perf_counter()
+        steps = recipe.epochs * len(batch_indices(lengths, recipe.batch_size, torch.Generator(),
+                                                  recipe.length_batches))
         for _ in range(recipe.epochs):
             model.train()
             terms = []
-            for index in torch.randperm(n, generator=gen).split(recipe.batch_size):
+            for index in batch_indices(lengths, recipe.batch_size, gen, recipe.length_batches):
                 alternative = (torch.randint(0, 8, (len(index),), generator=gen) if draw
                                else torch.zeros(len(index), dtype=torch.long))      # PRAE: one description
                 batch = make_batch(data, index, signal_ids("repeat both", len(index)), alternative)
                 batch.action_input = add_input_noise(batch.action_input, recipe.input_noise,
                                                      recipe.joint_input_noise)
-                for group in optimiser.param_groups:                                 # warm-up, cosine decay
-                    group["lr"] = recipe.lr * lr_factor(step, steps, recipe.warmup, recipe.schedule)
+                for group in optimiser.param_groups:         # warm-up, cosine decay; a tuned top layer's lr_scale
+                    group["lr"] = recipe.lr * lr_factor(step, steps, recipe.warmup, recipe.schedule) * group["lr_scale"]
                 loss, parts = family_loss(model, batch, weights)
                 optimiser.zero_grad()
                 loss.backward()

@@ -48,7 +48,9 @@ class ModelConfig:
     language_encoder: str = "lstm"
     pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
     # Not in the paper (which keeps the transformer frozen): with "pretrained-attention", free text reads
-    # the transformer's top layer trained (bert/tuned_layer.py); the 869 fixed inputs stay frozen.
+    # the transformer's top layer trained (bert/tuned_layer.py); the 869 fixed inputs stay frozen. With
+    # "pretrained", every input reads it, mean-pooled: PVAE-BERT's fine-tuning, at the top layer
+    # (bert/tuned_encoder.py).
     tuned_top_layer: bool = False
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
     # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
@@ -103,9 +105,9 @@ class ModelConfig:
                              f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
         if not isinstance(self.tuned_top_layer, bool):
             raise ValueError(f"tuned_top_layer must be True or False; got {self.tuned_top_layer!r}")
-        if self.tuned_top_layer and self.language_encoder != "pretrained-attention":
-            raise ValueError(f"tuned_top_layer needs language_encoder='pretrained-attention' (the free-form "
-                             f"variant's encoder); got language_encoder={self.language_encoder!r}")
+        if self.tuned_top_layer and self.language_encoder == "lstm":
+            raise ValueError(f"tuned_top_layer needs a pretrained language encoder ('pretrained' or "
+                             f"'pretrained-attention'); got language_encoder={self.language_encoder!r}")
 
     @property
     def state_dim(self) -> int:

@@ -5,7 +5,7 @@
 - ``new_colour``  the same pipeline for a world with a new colour (appendix A3)
 - ``reproduce``   every row of Table 1 over seeds (``python -m pgae_lite reproduce``)
 - ``table1_unit`` one training of one seed, measured on its rows: a unit of reproduce's sweep
-- ``configured_unit`` such a unit for a model configured per direction (PRAE, PVAE, PVAE-BERT), N.A. cells
+- ``configured_unit`` such a unit for a model configured per direction (PRAE, PVAE, PVAE-BERT(-tuned)), N.A. cells
 - ``sweep``       many trainings as tasks on a Dask cluster, from a laptop to a lab's cluster
 - ``sweep_worker`` every worker of a sweep set up for these trainings (one thread, malloc thresholds)
 - ``results``     the committed result files, read and quoted by the book and the README

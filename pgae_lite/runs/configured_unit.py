@@ -1,4 +1,4 @@
-"""One unit of ``reproduce`` for a model configured per direction: PRAE, PVAE or PVAE-BERT, one seed.
+"""One unit of ``reproduce`` for a model configured per direction: PRAE, PVAE or PVAE-BERT(-tuned), one seed.
 
 PGAE paper, Sec. 2 and 4 (PRAE, PVAE, their N.A. cells). The rows of
 :data:`pgae_lite.config.CONFIGURED_ROWS` are trained by :func:`pgae_lite.family.train.train_family`

@@ -68,7 +68,7 @@ def table1_unit(original_data: str | None, profile: Profile, training: str, seed
     Predictions}}, "normaliser": the statistics it was trained on, "made_on": host and cache}``.
     """
     dataset = worker_dataset(original_data, profile, device)
-    if training in CONFIGURED_ROWS:         # PRAE, PVAE, PVAE-BERT: measured per configuration, N.A. cells
+    if training in CONFIGURED_ROWS:         # PRAE, PVAE, PVAE-BERT(-tuned): per configuration, N.A. cells
         return configured_unit(dataset, profile, training, seed, out, device)
     prof = unit_profile(profile, training, seed, pretrained_model)
     trained = train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)

@@ -1,0 +1,110 @@
+"""The pretrained encoder with its top layer tuned on every input: PVAE-BERT's fine-tuning, at the top layer.
+
+PGAE paper, Sec. 3 ("Language Autoencoder", last paragraph) keeps PGAE-BERT's transformer frozen;
+PVAE-BERT (Özdemir et al., IEEE TCDS 2022) fine-tunes the whole of BERT-base and mean-pools its
+tokens. Deviation from paper (PVAE-BERT's): only the top layer of the transformer this project
+ships is tuned (:class:`~pgae_lite.bert.tuned_layer.TunedTopLayer`, the same layer the free-form
+variant tunes), and every input reads it, the dataset's own descriptions included. The layers below
+stay frozen, so for each of the 869 fixed inputs the top layer's input x is computed once and cached
+on disk, and a step runs the top layer alone on its batch's rows. With x_1..x_T the top layer's
+input over one text's real tokens::
+
+    y_1..y_T = TopLayer(x_1..x_T)           the tuned layer (tuned_layer.py's two blocks)
+    f        = 1/T Σ_t y_t                  (D,), the mean over real tokens, as PVAE-BERT pools
+
+In training, the top layer learns from one call in :data:`~pgae_lite.bert.tuned_layer.TRAIN_EVERY`
+and runs forward only on the others, at :data:`~pgae_lite.bert.tuned_layer.LR_SCALE` of the
+recipe's rate, without weight decay: the schedule the free-form variant's tuning uses, which keeps
+PVAE-BERT-tuned's training within 1.5x PGAE's (results/family-*.json).
+"""
+from __future__ import annotations
+
+import torch
+from torch import nn
+
+from pgae_lite.bert.attention_pooling import cached_token_vectors, padded_token_vectors
+from pgae_lite.bert.pretrained import (
+    Transformer,
+    check_texts,
+    check_token_ids,
+    fixed_inputs,
+    load_transformer,
+    model_name,
+    table_rows,
+    tokens_to_text,
+)
+from pgae_lite.bert.tuned_layer import TRAIN_EVERY, TunedTopLayer
+
+
+def mean_over_tokens(states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Token vectors (B, T, D) and their mask (B, T) -> the mean over real tokens (B, D)."""
+    weight = mask[..., None].to(states.dtype)                        # (B, T, 1)
+    return (states * weight).sum(1) / weight.sum(1)                  # f = 1/T Σ_t y_t
+
+
+class TunedPretrainedEncoder(nn.Module):
+    """Frozen transformer below its top layer -> the tuned top layer -> mean over tokens -> (B, output_dim).
+
+    Called like PGAE-BERT's :class:`~pgae_lite.bert.pretrained.PretrainedLanguageEncoder`: ``lang_tokens``
+    rows in ``forward``, any text in :meth:`encode_texts`. The transformer stays outside the module tree
+    (frozen, in no optimiser); ``top``, a copy of its top layer, is the only trained part.
+    """
+
+    pooling = "mean"
+    reads_free_text = True
+
+    def __init__(self, name: str | None = None):
+        super().__init__()
+        self.name = model_name(name)
+        self.output_dim = int(self.transformer.model.config.hidden_size)
+        self.texts, row_of_code = fixed_inputs()
+        states, mask = cached_token_vectors(self.transformer, self.texts, "fixed", top_input=True)
+        self.register_buffer("states", states, persistent=False)             # (869, T, D): the top layer's input
+        self.register_buffer("mask", mask, persistent=False)                 # (869, T)
+        self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
+        self.top = TunedTopLayer(self.transformer)
+        self.calls = 0                                                       # training calls, for TRAIN_EVERY
+
+    @property
+    def transformer(self) -> Transformer:
+        """The loaded tokenizer and model (loaded on first use in this process)."""
+        return load_transformer(self.name)
+
+    def read_as(self, text: str) -> str:
+        """The text as this encoder reads it: as it is (the transformer reads any text)."""
+        return text
+
+    def pool(self, states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        """The top layer's input (B, T, D) and mask (B, T) -> f (B, D), through the tuned layer."""
+        device = self.mask.device
+        states, mask = states.to(device, torch.float32), mask.to(device)
+        longest = int(mask.any(0).nonzero().max()) + 1                       # drop columns of padding only
+        states, mask = states[:, :longest], mask[:, :longest]                # (B, T', D), (B, T')
+        learn = self.training and torch.is_grad_enabled()
+        if learn:
+            learn, self.calls = self.calls % TRAIN_EVERY == 0, self.calls + 1
+        with torch.set_grad_enabled(learn):
+            return mean_over_tokens(self.top(states, mask), mask)
+
+    def encode_texts(self, texts: list[str]) -> torch.Tensor:
+        """Any texts -> f (B, output_dim), the signal phrase first: ``["repeat both push the red one"]``."""
+        texts = check_texts("encode_texts", texts)
+        return self.pool(*padded_token_vectors(self.transformer, texts, top_input=True))
+
+    def forward(self, tokens: torch.Tensor, lengths: torch.Tensor | None = None) -> torch.Tensor:
+        """``lang_tokens`` (B, 5) -> (B, output_dim); rows outside the fixed 869 run the frozen layers first.
+
+        ``lengths`` is not needed (a row's text ends at its first <EOS>); it is accepted so that every
+        language encoder is called the same way."""
+        rows = table_rows(check_token_ids(tokens), self.row_of_code).to(self.mask.device)
+        missing = (rows < 0).nonzero().flatten()
+        if not len(missing):
+            return self.pool(self.states[rows], self.mask[rows])
+        texts = [tokens_to_text(row) for row in tokens.cpu()]
+        return self.encode_texts(texts)
+
+    def extra_repr(self) -> str:
+        return f"{self.name!r}, pooling='mean', top layer tuned on every input"
+
+
+__all__ = ["TunedPretrainedEncoder", "mean_over_tokens"]
