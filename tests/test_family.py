@@ -329,3 +329,18 @@ def test_reproduce_takes_a_configured_row_writes_na_as_null_and_loads_its_model_
     again = reproduce(original_data, **args)                                    # loaded, not trained again
     assert (tmp_path / "PVAE-seed0" / "family.pt").stat().st_mtime_ns == saved
     assert again["rows"]["PVAE"]["mean"] == report["rows"]["PVAE"]["mean"]
+
+
+def test_a_model_saved_by_an_older_training_code_is_refused_not_loaded(toy_short, tmp_path):
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.configured_unit import configured_profile, trained_configured
+    from pgae_lite.util.storage import CheckpointMismatchError, load_torch, save_torch
+
+    prof = configured_profile(get_profile("smoke"), "PRAE", 0, len(toy_short.split("train")))
+    path = tmp_path / "PRAE-seed0" / "family.pt"
+    trained_configured(path, "PRAE", prof, toy_short, "cpu")
+    saved = load_torch(path, ("name", "training_version"), "family model")
+    saved["training_version"] = 1                                               # as the first version saved it
+    save_torch(saved, path)
+    with pytest.raises(CheckpointMismatchError, match="trained by an older training code .version 1"):
+        trained_configured(path, "PRAE", prof, toy_short, "cpu")

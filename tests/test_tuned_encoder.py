@@ -63,3 +63,18 @@ def test_the_config_builds_it_for_pretrained_with_tuned_top_layer():
     assert isinstance(built, TunedPretrainedEncoder)
     with pytest.raises(ValueError, match="tuned_top_layer needs a pretrained language encoder"):
         ModelConfig(language_encoder="lstm", tuned_top_layer=True)
+
+
+def test_after_stop_learning_the_table_gives_what_the_layer_gives():
+    encoder = TunedPretrainedEncoder().train()
+    with torch.no_grad():
+        encoder.top.outer.bias.add_(0.5)                    # as if it had learned something
+    rows = fixed_token_rows()[::50]
+    encoder.stop_learning()
+    assert not any(p.requires_grad for p in encoder.top.parameters())
+    from_table = encoder(rows)
+    assert not from_table.requires_grad
+    encoder.table = None                                    # the layer itself, without dropout
+    with torch.no_grad():
+        on_the_fly = encoder.eval()(rows)
+    torch.testing.assert_close(from_table, on_the_fly, atol=1e-5, rtol=1e-4)

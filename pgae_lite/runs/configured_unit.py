@@ -17,7 +17,7 @@ from pathlib import Path
 from pgae_lite.config import Profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.family.configured import evaluate_configured
-from pgae_lite.family.train import MODELS, FamilyTrained, family_recipe, train_family
+from pgae_lite.family.train import MODELS, TRAINING_VERSION, FamilyTrained, family_recipe, train_family
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.train.checkpoint import check_trained_on, training_split
 from pgae_lite.util.storage import CheckpointMismatchError, cache_dir, load_torch, save_torch
@@ -42,6 +42,10 @@ def _load(path: Path, name: str, prof: Profile, fitted: dict, source: str) -> Fa
     if saved["name"] != name or saved["profile"] != prof.to_dict():
         raise CheckpointMismatchError(f"{path} holds another model or recipe ({saved['name']}); use another "
                                       "output folder, or delete it to train again")
+    if saved.get("training_version", 1) != TRAINING_VERSION:
+        raise CheckpointMismatchError(f"{path} was trained by an older training code (version "
+                                      f"{saved.get('training_version', 1)}, this one is {TRAINING_VERSION}); use "
+                                      "another output folder, or delete it to train again")
     check_trained_on(saved, fitted, path, source)
     make, changes = MODELS[name]
     model = make(replace(ModelConfig(**saved["profile"]["model"]), **changes))
@@ -60,7 +64,8 @@ def trained_configured(path: Path, name: str, prof: Profile, dataset: PGAEDatase
     trained = _load(path, name, prof, fitted, dataset.source)
     if trained is None:
         trained = train_family(name, dataset, prof.model, prof.train, device, all_descriptions)
-        save_torch({"name": name, "model": trained.model.state_dict(), "profile": prof.to_dict(),
+        save_torch({"name": name, "training_version": TRAINING_VERSION,
+                    "model": trained.model.state_dict(), "profile": prof.to_dict(),
                     "normaliser": trained.normaliser.state_dict(), "history": trained.history,
                     "seconds": trained.seconds}, path)
     return trained

@@ -18,7 +18,7 @@ import os
 from pathlib import Path
 
 from pgae_lite.config import TRAININGS, Profile, get_profile
-from pgae_lite.family.train import FamilyTrained
+from pgae_lite.family.train import TRAINING_VERSION, FamilyTrained
 from pgae_lite.runs.configured_unit import SAVED, configured_profile, trained_configured
 from pgae_lite.runs.pipeline import is_trained, model_folder, simulated_dataset, trained_pgae
 from pgae_lite.runs.sweep import run_sweep
@@ -30,9 +30,9 @@ FAMILY_UNITS = {"PRAE-8": ("PRAE", True), "PVAE": ("PVAE", None)}
 
 def _saved_at(name: str, prof: Profile, seed: int, data) -> tuple[Profile, Path]:
     """The recipe of a family unit and where its model is cached: beside the PGAEs, under the data's, the
-    CAE's and the recipe's digests and the unit's own name (PRAE-8 is not PRAE)."""
+    CAE's and the recipe's digests, the unit's own name (PRAE-8 is not PRAE) and the training code's version."""
     prof = configured_profile(prof, FAMILY_UNITS[name][0], seed, len(data.split("train")))
-    return prof, model_folder(prof, name) / SAVED
+    return prof, model_folder(prof, f"{name}-training{TRAINING_VERSION}") / SAVED
 
 
 def _unit(name: str, profile: Profile, seed: int, device: str | None = None) -> FamilyTrained | float:
