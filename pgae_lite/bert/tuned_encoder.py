@@ -89,9 +89,9 @@ class TunedPretrainedEncoder(nn.Module):
 
     @torch.no_grad()
     def stop_learning(self) -> None:
-        """The top layer learns no more: its weights are frozen, and f of the 869 fixed inputs is computed
-        once (without dropout) and read from a table from now on; free text still runs the top layer."""
-        self.top.requires_grad_(False)
+        """The top layer learns no more: f of the 869 fixed inputs is computed once (without dropout) and read
+        from a table from now on, so no gradient reaches the layer (it still counts among the trained
+        parameters); free text still runs the top layer, without recording gradients."""
         training, self.table = self.top.training, None
         self.top.eval()
         self.table = torch.cat([self.pool(self.states[i:i + 128], self.mask[i:i + 128])
@@ -104,7 +104,7 @@ class TunedPretrainedEncoder(nn.Module):
         states, mask = states.to(device, torch.float32), mask.to(device)
         longest = int(mask.any(0).nonzero().max()) + 1                       # drop columns of padding only
         states, mask = states[:, :longest], mask[:, :longest]                # (B, T', D), (B, T')
-        learn = self.training and torch.is_grad_enabled() and self.table is None
+        learn = self.training and torch.is_grad_enabled() and self.table is None      # None: still learning
         if learn:
             learn, self.calls = self.calls % TRAIN_EVERY == 0, self.calls + 1
         with torch.set_grad_enabled(learn):
