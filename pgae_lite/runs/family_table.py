@@ -25,11 +25,12 @@ def cell_text(stats: dict | None, fmt: str) -> str:
     return f"{stats['median']:{fmt}} [{stats['min']:{fmt}}, {stats['max']:{fmt}}]"
 
 
-def family_frame(source: str) -> pd.DataFrame:
+def family_frame(source: str, result: str | None = None) -> pd.DataFrame:
     """The family table on ``source`` (``"original"`` or ``"ours"``): a row per model, each task's words and
-    nRMSE, the median training time (s) and the trainable parameters."""
+    nRMSE, the median training time (s) and the trainable parameters. ``result``: another result file of
+    ``benchmarks/family.py`` than ``family-SOURCE`` (e.g. ``"family_length_batches"``)."""
     out = {}
-    for name, row in results.value(f"family-{source}", "rows").items():
+    for name, row in results.value(result or f"family-{source}", "rows").items():
         line = {(signal, what): cell_text(row["stats"][signal][key], fmt)
                 for signal in TEST_SIGNALS for what, key, fmt in MEASURES}
         line[("", "time (s)")] = f"{np.median(row['train_seconds']):.0f}"
