@@ -14,7 +14,7 @@ input over one text's real tokens::
 
 In training, the top layer learns from one call in :data:`~pgae_lite.bert.tuned_layer.TRAIN_EVERY`
 and runs forward only on the others, as the free-form variant's does, without weight decay, at
-:data:`TUNED_LR_SCALE` of the recipe's rate: a tenth of the free-form variant's, at which the tuned
+:data:`TUNED_LR_SCALE` of the recipe's rate: a tenth of the free-form variant's rate, at which this
 layer lost what the words say (chosen on our data's training split, ``benchmarks/tuned_rate.py``). Deviation
 from paper (PVAE-BERT's tunes all along): PVAE-BERT-tuned's training (``family.train``) tunes it in
 the first :data:`TUNED_SHARE` of its steps, then calls :meth:`TunedPretrainedEncoder.stop_learning`,
