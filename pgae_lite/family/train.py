@@ -31,7 +31,6 @@ from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.train.checkpoint import training_split
 from pgae_lite.train.config import TrainConfig
-from pgae_lite.train.loop import batch_indices
 from pgae_lite.train.loss import add_input_noise, lr_factor, parameter_groups, pgae_loss
 from pgae_lite.util.storage import default_device, training_threads
 from pgae_lite.world.words import word_weights
@@ -109,13 +108,13 @@ def train_family(name: str, dataset: PGAEDataset, model_cfg: ModelConfig | None 
         fused = dict(fused=True) if device.type in ("cpu", "cuda") else {}   # one kernel, as PGAE's loop
         optimiser = torch.optim.AdamW(parameter_groups(model), lr=recipe.lr, weight_decay=recipe.weight_decay,
                                       **fused)
-        lengths, history, step, t0 = data["lengths"].cpu(), [], 0, time.perf_counter()
-        steps = recipe.epochs * len(batch_indices(lengths, recipe.batch_size, torch.Generator(), by_length=False))
+        n, history, step, t0 = len(train_set), [], 0, time.perf_counter()
+        steps = recipe.epochs * -(-n // recipe.batch_size)
         stop_tuning = round(TUNED_SHARE * steps) if hasattr(model.language_encoder, "stop_learning") else None
         for _ in range(recipe.epochs):
             model.train()
             terms = []
-            for index in batch_indices(lengths, recipe.batch_size, gen, by_length=False):   # any samples
+            for index in torch.randperm(n, generator=gen).split(recipe.batch_size):      # batches of any samples
                 if step == stop_tuning:                     # a tuned top layer: its share of the steps is over
                     model.language_encoder.stop_learning()
                 alternative = (torch.randint(0, 8, (len(index),), generator=gen) if draw
