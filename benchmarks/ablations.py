@@ -25,7 +25,7 @@ import torch
 from harness import Benchmark, side_by_side
 from pgae_lite.world import words as language
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate import evaluate
+from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.model.layers import ConcatBottleneck

@@ -11,7 +11,7 @@ paper's execute (the decoder reads the recorded vision), and closed loop (it
 reads what its own motion shows). Prints the success rate per action and
 speed and the time per episode; writes the success rates, their gap and every
 failed closed-loop episode to results/closed_loop.json, with the model's Table 1
-cells on the same data (:func:`pgae_lite.evaluate.evaluate`) and whether its h says
+cells on the same data (:func:`pgae_lite.evaluate.table1.evaluate`) and whether its h says
 which cube to move (:func:`pgae_lite.model.plan.which_cube_probe`; ``PGAE-no-plan`` is the
 recipe without the plan head). ``--limit N`` takes N
 episodes evenly spread over the 216 of the test split. The models are small:
@@ -33,7 +33,7 @@ from pgae_lite.robot.closedloop import compare, success_summary
 from pgae_lite.config import get_profile
 from pgae_lite.runs.trainings import by_name
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.evaluate import evaluate
+from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.model.plan import which_cube_probe
 

@@ -15,7 +15,7 @@ mechanisms; each row here adds one to the row before it:
 
 and each row's execution by both *routes*: ``direct`` (the paper's: the sentence's features
 into execute) and ``said back`` (the model's readback words executed). Rows 2 to 5 train
-without the held-out words (:func:`pgae_lite.bert.phrase_lexicon.held_out_words`), so that
+without the held-out words (:func:`pgae_lite.freeform.phrase_lexicon.held_out_words`), so that
 "unseen" is the same subset of sentences for every row: the paraphrases with a word that
 occurs nowhere in those rows' training language. Rows 1 to 4 are measured without the lookup.
 
@@ -23,7 +23,7 @@ Each of the 216 test episodes is told one of the 108 held-out paraphrases of its
 (never trained on). Readback: the paraphrase under repeat language, no pictures of the action:
 is the generated description the intended one? Execution: the paraphrase under execute in the
 simulator, open loop, judged by the simulator (did the named cube move the named way?); an
-instruction the robot refuses (:mod:`pgae_lite.robot.refusals`) is not executed and counts as not done.
+instruction the robot refuses (:mod:`pgae_lite.freeform.refusals`) is not executed and counts as not done.
 Writes results/free_form_ablation.json.
 """
 from __future__ import annotations
@@ -35,10 +35,10 @@ import torch
 
 from free_language import training_words, words
 from harness import Benchmark, side_by_side
-from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.config import TRAININGS, Training, get_profile
-from pgae_lite.evaluate import predict
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae

@@ -8,7 +8,7 @@
 Both models are trained (or loaded from the cache) on the profile's simulated
 data: ``PGAE-BERT`` reads the dataset's descriptions only; ``PGAE-BERT-phrasings``
 also reads generated sentences that say them in other words
-(:mod:`pgae_lite.bert.phrasing_bank`). Each of the 216 test episodes is told one of
+(:mod:`pgae_lite.freeform.phrasing_bank`). Each of the 216 test episodes is told one of
 the 108 held-out paraphrases of its instruction (``pgae_lite/paraphrases.tsv``,
 never trained on), and measured three ways:
 
@@ -23,14 +23,14 @@ never trained on), and measured three ways:
 - the canonical Table 1 cells of the model on the same data.
 
 A variant trained on phrasings reads free text through its WordNet lookup
-(:mod:`pgae_lite.bert.word_lookup`); its readback is also measured without the
+(:mod:`pgae_lite.freeform.word_lookup`); its readback is also measured without the
 lookup (``*_no_lookup_%``), and ``looked_up`` lists the words it replaced.
 
 The "unseen" subset holds the paraphrases with a word that occurs nowhere in the
 model's training language (the descriptions, plus the phrasings' lexicon for the
 variant). The full lexicon holds every word of the paraphrases, so that subset
 is measured with ``PGAE-BERT-phrasings-held-out``, trained without the words of
-:func:`pgae_lite.bert.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
+:func:`pgae_lite.freeform.phrase_lexicon.held_out_words` (a rule on the lexicon alone).
 Writes results/free_language.json.
 
 With ``--original-data`` it measures only the canonical Table 1 of each training on
@@ -57,12 +57,12 @@ from harness import Benchmark, side_by_side
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.config import get_profile, training_profile
 from pgae_lite.runs.trainings import by_name
-from pgae_lite.evaluate import evaluate, predict
+from pgae_lite.evaluate.table1 import evaluate, predict
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
 from pgae_lite.world.words import SIGNALS, VOCABULARY
 from pgae_lite.data.original import load_original
-from pgae_lite.bert.paraphrases import load_paraphrases
-from pgae_lite.bert.phrase_lexicon import training_lexicon
+from pgae_lite.freeform.paraphrases import load_paraphrases
+from pgae_lite.freeform.phrase_lexicon import training_lexicon
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.bert.pretrained import input_text, load_transformer
 from pgae_lite.train.loop import train

@@ -13,7 +13,7 @@
         main()
 
 The work runs under the ``__main__`` guard: recording the simulated data
-(:func:`pgae_lite.data.simulated.generate`, which :func:`pgae_lite.runs.pipeline.simulated_dataset`
+(:func:`pgae_lite.sim.dataset.generate`, which :func:`pgae_lite.runs.pipeline.simulated_dataset`
 and ``trained_cae`` call when the cache lacks it) and a sweep's local cluster
 (:func:`side_by_side`) spawn worker processes, and each re-imports the script;
 unguarded, they would run the benchmark again.

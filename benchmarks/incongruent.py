@@ -4,7 +4,7 @@
 
 Loads the models ``benchmarks/family.py`` trained on the authors' data into ``--models`` (or
 trains them there, with the same recipe and seeds) and runs both experiments of
-``pgae_lite.runs.incongruent`` on the test split: language conflicts (describe, one word of the
+``pgae_lite.evaluate.incongruent`` on the test split: language conflicts (describe, one word of the
 description swapped) and action conflicts (execute, another pattern's recording shown).
 Writes results/incongruent.json: every model's and seed's cells, and their medians.
 """
@@ -20,7 +20,7 @@ def run(model: str, seed: int, profile_name: str, original: str, models: str) ->
     import torch
 
     from pgae_lite.config import get_profile, training_profile
-    from pgae_lite.runs.incongruent import incongruent_cells
+    from pgae_lite.evaluate.incongruent import incongruent_cells
     from pgae_lite.runs.pipeline import train_when_free
     from pgae_lite.runs.table1_unit import worker_dataset
 

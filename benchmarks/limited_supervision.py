@@ -37,7 +37,7 @@ def run(model: str, reading: str, share: float, seed: int, profile_name: str, or
     import torch
 
     from pgae_lite.config import get_profile, training_profile
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.runs.pipeline import train_when_free
     from pgae_lite.runs.table1_unit import worker_dataset
 

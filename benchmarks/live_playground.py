@@ -14,7 +14,7 @@ Chromium, each time in a fresh browser context (an empty cache), once per model:
 - ``seconds_to_first_result``: from navigation start to that first result;
 - ``seconds_per_run``: the median of ``--runs`` further runs on other test episodes.
 
-Then, for the PGAE-BERT models, free text (the project's paraphrases, bert/paraphrases.tsv), in the
+Then, for the PGAE-BERT models, free text (the project's paraphrases, freeform/paraphrases.tsv), in the
 same page: ``free_text_bytes``, every response body from the first free text until its result (the
 tokenizer, the sentence encoder, the model's head and word table); ``seconds_to_first_free_text``;
 ``seconds_per_free_text`` (the median over ``--runs`` further sentences); and ``parity``: every
@@ -42,7 +42,7 @@ from harness import ROOT, Benchmark
 sys.path.insert(0, str(ROOT / "tests"))
 from browser_support import CHROMIUM, CHROMIUM_FLAGS, serve  # noqa: E402
 
-from pgae_lite.bert.paraphrases import load_paraphrases  # noqa: E402
+from pgae_lite.freeform.paraphrases import load_paraphrases  # noqa: E402
 from pgae_lite.web.assets import MODELS, export_web  # noqa: E402
 
 LIVE = ("/_static/ort/", "/_static/web/", "/_static/pgae", "/_static/tokenizers/")
@@ -143,7 +143,7 @@ def parity(site: str, browser, name: str, manifest: dict, per_kind: int) -> dict
     import numpy as np
     from refusals import CLASSES, sentence
 
-    from pgae_lite.robot.refusals import refusal
+    from pgae_lite.freeform.refusals import refusal
     from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
     from pgae_lite.web.sentence import free_text_reference
 

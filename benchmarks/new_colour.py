@@ -65,7 +65,7 @@ def main() -> None:
     import torch
 
     from pgae_lite.runs import new_colour as extended
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.exercises import check_new_colour
 
     world = with_colour(args.colour, args.synonym, args.rgba)

@@ -28,7 +28,7 @@ def run(variant: str, seed: int, profile_name: str, original: str) -> dict:
     import torch
 
     from pgae_lite.config import get_profile, training_profile
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.model.pgae import count_parameters
     from pgae_lite.runs.table1_unit import worker_dataset
     from pgae_lite.train.loop import train

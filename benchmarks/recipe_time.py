@@ -18,7 +18,7 @@ from dataclasses import replace
 
 from harness import Benchmark
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate import evaluate
+from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.data.original import load_original
 from pgae_lite.train.loop import train
 

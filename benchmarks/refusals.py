@@ -13,9 +13,9 @@ must refuse, each told in a scene of two cubes (a random arrangement):
 - ``outside_action``: an action the robot cannot do ("lift", "rotate", "throw", ...);
 
 and one class it must act on, ``valid``: one instruction for a cube on the table. Each sentence
-is judged by :func:`pgae_lite.robot.refusals.refusal` with the trained free-form model's encoder
+is judged by :func:`pgae_lite.freeform.refusals.refusal` with the trained free-form model's encoder
 and its readback of the sentence (``repeat language``, in an episode of the scene). Then the 108
-held-out paraphrases (``pgae_lite/bert/paraphrases.tsv``), as :func:`execute_paraphrases` tells
+held-out paraphrases (``pgae_lite/freeform/paraphrases.tsv``), as :func:`execute_paraphrases` tells
 them to the 216 test episodes: how many are still executed (the refusal must not cost them).
 Writes results/refusals.json: per class, the share refused, and examples of each outcome.
 """
@@ -25,10 +25,10 @@ import random
 
 from harness import Benchmark
 
-from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import paraphrase_of, say_back, scene_of
-from pgae_lite.robot.refusals import refusal
+from pgae_lite.freeform.refusals import refusal
 from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.runs.trainings import by_name
 from pgae_lite.world.patterns import ARRANGEMENTS, pattern_parts

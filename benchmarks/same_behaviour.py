@@ -76,7 +76,8 @@ for name, model in models.items():
 
 bench = Benchmark("same_behaviour", __doc__)
 bench.parser.add_argument("--base", required=True, help="the commit to compare HEAD with")
-bench.parser.add_argument("--head", default="HEAD", help="the commit compared with the base (default: HEAD)")
+bench.parser.add_argument("--head", default="HEAD", help="the commit compared with the base (default: HEAD; "
+                          "'.': this checkout as it is, uncommitted changes included)")
 bench.parser.add_argument("--reuse", action="store_true", help="the head evaluates the base's trained models")
 bench.parser.add_argument("--rows", default="all", help="rows as reproduce takes them, or 'every' (default: all)")
 bench.parser.add_argument("--data", choices=("original", "ours"), default="original",
@@ -93,10 +94,11 @@ def git(*args: str) -> str:
 def start(side: str, rev: str, work: Path, args, start_from: Path | None = None) -> tuple[Path, list]:
     """Start ``reproduce`` (and the side models) at commit ``rev`` in a worktree of its own; the output folder
     (a copy of ``start_from``) and the process."""
-    tree, out = work / f"tree-{side}", work / f"out-{side}"
+    tree, out = (ROOT if rev == "." else work / f"tree-{side}"), work / f"out-{side}"
     if start_from is not None:
         shutil.copytree(start_from, out)
-    git("worktree", "add", "--detach", str(tree), rev)
+    if rev != ".":
+        git("worktree", "add", "--detach", str(tree), rev)
     env = {**os.environ, "PYTHONPATH": str(tree), "PGAE_LITE_CACHE": str(work / f"cache-{side}"),
            "OMP_NUM_THREADS": "1", "PYTHONHASHSEED": "0", "PGAE_LITE_PROFILE": args.profile}
     env.pop("PGAE_ORIGINAL_DATA", None)
@@ -116,7 +118,8 @@ def finish(rev: str, handle: list) -> None:
     process, tree, log = handle
     rc = process.wait()
     log.close()
-    git("worktree", "remove", "--force", str(tree))
+    if rev != ".":
+        git("worktree", "remove", "--force", str(tree))
     if rc:
         raise SystemExit(f"{rev}: the run failed (exit {rc}); its output:\n{Path(log.name).read_text()[-3000:]}")
 
@@ -175,7 +178,8 @@ if __name__ == "__main__":
     args = bench.parse()
     bench.name = (f"same_behaviour-{args.profile}" + ("-ours" if args.data == "ours" else "")
                   + ("-reused" if args.reuse else ""))
-    base, head = git("rev-parse", "--short", args.base), git("rev-parse", "--short", args.head)
+    base = git("rev-parse", "--short", args.base)
+    head = "." if args.head == "." else git("rev-parse", "--short", args.head)
     with tempfile.TemporaryDirectory() as work:
         work = Path(work)
         before, handle = start("base", base, work, args)

@@ -16,7 +16,7 @@ import statistics
 from pathlib import Path
 
 from pgae_lite.config import ROWS, get_profile
-from pgae_lite.evaluate import PAPER_TABLE
+from pgae_lite.evaluate.table1 import PAPER_TABLE
 from pgae_lite.world.words import TEST_SIGNALS
 from pgae_lite.runs.reproduce import parse_rows, run_table1
 

@@ -15,7 +15,7 @@ import torch
 from dataclasses import replace
 
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate import evaluate
+from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.data.original import load_original
 from pgae_lite.runs.pipeline import simulated_dataset
 from pgae_lite.train.loop import train

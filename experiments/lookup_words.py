@@ -2,13 +2,13 @@
 
     python experiments/lookup_words.py
 
-No PGAE, no transformer, no training: :class:`pgae_lite.bert.word_lookup.WordLookup`
+No PGAE, no transformer, no training: :class:`pgae_lite.freeform.word_lookup.WordLookup`
 alone, on the one-word phrases of the lexicon (not the dataset's own words),
 each of which has a meaning. Two settings:
 
 - *leave one out*: each word is taken out of the lexicon (``LEXICON.without(word)``)
   and looked up with what is left, as if the training had never held it;
-- *held out*: the words of :func:`pgae_lite.bert.phrase_lexicon.held_out_words`,
+- *held out*: the words of :func:`pgae_lite.freeform.phrase_lexicon.held_out_words`,
   looked up with the lexicon of ``PGAE-BERT-phrasings-held-out``.
 
 A word is read *right* (replaced by a phrase of its own meaning), *wrong*
@@ -21,9 +21,9 @@ import argparse
 from collections import Counter
 
 from pgae_lite.world.words import VOCABULARY
-from pgae_lite.bert.paraphrases import load_paraphrases
-from pgae_lite.bert.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
-from pgae_lite.bert.word_lookup import WordLookup
+from pgae_lite.freeform.paraphrases import load_paraphrases
+from pgae_lite.freeform.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
+from pgae_lite.freeform.word_lookup import WordLookup
 
 argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()   # no options: --help only
 test_words = {w for p in load_paraphrases() for w in words_of(p.text)}

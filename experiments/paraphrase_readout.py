@@ -37,7 +37,7 @@ from pathlib import Path
 import torch
 
 from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, SYNONYMS
-from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, input_text
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -20,7 +20,7 @@ from pathlib import Path
 import torch
 
 from pgae_lite.world.words import VOCABULARY, parse_description
-from pgae_lite.bert.paraphrases import load_paraphrases
+from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -3,10 +3,10 @@
     python experiments/pooling_probe.py [--per-meaning 60] [--threads 2]
 
 No PGAE: the frozen transformer (all-MiniLM-L6-v2) encodes K generated
-phrasings of each of the 36 meanings (grammar seed 0, :mod:`pgae_lite.bert.phrasings`)
+phrasings of each of the 36 meanings (grammar seed 0, :mod:`pgae_lite.freeform.phrasings`)
 with ``repeat language`` in front; a classifier of the 36 meanings is trained on
 them through one pooling (the mean, the maximum, or an attention pooling with
-1, 4 or 8 heads, :class:`pgae_lite.bert.attention_pooling.AttentionPooling`) and a
+1, 4 or 8 heads, :class:`pgae_lite.freeform.attention_pooling.AttentionPooling`) and a
 linear or one-hidden-layer head, and scored on 12 phrasings per meaning of
 another grammar seed (4242, the validation sentences of
 ``validation_readback.py``). The test paraphrases are never read.
@@ -16,9 +16,9 @@ import itertools
 
 import torch
 
-from pgae_lite.bert.attention_pooling import AttentionPooling, padded_token_vectors
+from pgae_lite.freeform.attention_pooling import AttentionPooling, padded_token_vectors
 from pgae_lite.world.words import SLOTS
-from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import input_text, load_transformer
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

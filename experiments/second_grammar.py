@@ -1,13 +1,13 @@
 """A second grammar for validation: instructions in sentence forms the training grammar never writes.
 
-Not from the paper. The training phrasings (:mod:`pgae_lite.bert.phrasings`) say an
+Not from the paper. The training phrasings (:mod:`pgae_lite.freeform.phrasings`) say an
 instruction as an imperative clause inside politeness frames and carriers. A
 validation set drawn from that same grammar (``validation_readback.py``'s
 default) rewards a model for learning the grammar, not the language: at
 ``1a5fe47`` it no longer told the tuned top layer from the untuned variant on
 held-out words, though the test paraphrases did. This grammar says the same 36
 meanings, with the lexicon's words for action, colour and speed
-(:data:`pgae_lite.bert.phrase_lexicon.LEXICON`, held-out words included), in other
+(:data:`pgae_lite.freeform.phrase_lexicon.LEXICON`, held-out words included), in other
 forms: passives (``the red cube needs to be pushed away``), wanted end states
 (``I want the red cube closer to you``), the cube as subject of ``go``, questions
 of possibility, two steps (``reach for ..., then ...``), the speed as its own
@@ -22,8 +22,8 @@ import argparse
 import random
 import re
 
-from pgae_lite.bert.phrase_lexicon import LEXICON, MEANINGS, SLOTS
-from pgae_lite.bert.phrasings import gerund
+from pgae_lite.freeform.phrase_lexicon import LEXICON, MEANINGS, SLOTS
+from pgae_lite.freeform.phrasings import gerund
 
 #: Past participles the -ed rule gets wrong.
 _IRREGULAR = {"thrust": "thrust", "draw": "drawn", "slide": "slid", "sweep": "swept",
@@ -33,7 +33,7 @@ _IRREGULAR = {"thrust": "thrust", "draw": "drawn", "slide": "slid", "sweep": "sw
 def participle(verb: str) -> str:
     """``push`` -> ``pushed``, ``glide`` -> ``glided``, ``drag`` -> ``dragged``, ``draw`` -> ``drawn``.
 
-    The -ing form's stem (:func:`pgae_lite.bert.phrasings.gerund`: ``dragg``, ``glid``) plus ``ed``."""
+    The -ing form's stem (:func:`pgae_lite.freeform.phrasings.gerund`: ``dragg``, ``glid``) plus ``ed``."""
     return _IRREGULAR.get(verb) or gerund(verb)[:-len("ing")] + "ed"
 
 

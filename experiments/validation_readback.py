@@ -6,7 +6,7 @@
     python experiments/validation_readback.py PGAE-BERT-phrasings-held-out:0 --grammar second [--no-lookup]
 
 Each of the 216 test episodes is told, with ``repeat language``, one of 12
-sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.bert.phrasings`)
+sentences of its meaning that the phrasing grammar (:mod:`pgae_lite.freeform.phrasings`)
 generates with another seed than any training uses; the model's description
 must name the intended action, colour and speed. With ``--grammar second``
 the 12 sentences come from :mod:`second_grammar` instead (other sentence
@@ -14,7 +14,7 @@ forms, the same lexicon): a check that does not share the training grammar.
 This is the validation set a free-form variant is chosen on;
 ``pgae_lite/paraphrases.tsv`` stays the test set (``benchmarks/free_language.py``).
 The "held-out words" subset holds the sentences with a word of
-:func:`pgae_lite.bert.phrase_lexicon.held_out_words`.
+:func:`pgae_lite.freeform.phrase_lexicon.held_out_words`.
 Models are trained with the book profile, or loaded from the cache; ``name=value``
 after the seed changes one training option that the training itself does not set (a number,
 or names joined by ``+``).
@@ -27,15 +27,15 @@ import argparse
 import numpy as np
 import torch
 
-from pgae_lite.evaluate import predict
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.world.words import LanguageError, parse_description
 from pgae_lite.world.patterns import Pattern
-from pgae_lite.bert.phrase_lexicon import held_out_words, words_of
-from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.freeform.phrase_lexicon import held_out_words, words_of
+from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.config import TrainConfig, get_profile
 from pgae_lite.runs.trainings import by_name
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases
-from pgae_lite.bert.paraphrases import Paraphrase
+from pgae_lite.freeform.paraphrases import Paraphrase
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
 from pgae_lite.bert.pretrained import input_text
 from second_grammar import second_phrasings
@@ -65,7 +65,7 @@ parser.add_argument("--seed", type=int, default=4242, help="the phrasing grammar
 parser.add_argument("--grammar", choices=("training", "second"), default="training",
                     help="the training grammar with another seed, or experiments/second_grammar.py's forms")
 parser.add_argument("--no-lookup", action="store_true",
-                    help="read free text without the variant's WordNet lookup (pgae_lite/bert/word_lookup.py)")
+                    help="read free text without the variant's WordNet lookup (pgae_lite/freeform/word_lookup.py)")
 parser.add_argument("--closed", action="store_true", help="also execute the sentences in the closed loop")
 parser.add_argument("--routes", nargs="+", default=["direct"], choices=ROUTES,
                     help="how the closed loop reads the sentence (pgae_lite.robot.instructions.ROUTES)")

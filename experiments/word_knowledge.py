@@ -6,7 +6,7 @@ No PGAE, no training. Each one-word phrase of the lexicon is put into one
 carrier sentence per slot (``{} the red cube slowly`` for an action,
 ``push the {} cube slowly`` for a colour, ``push the red cube {}`` for a speed)
 and read as the mean of its token vectors there. A word of
-:func:`pgae_lite.bert.phrase_lexicon.held_out_words` is given the meaning of the
+:func:`pgae_lite.freeform.phrase_lexicon.held_out_words` is given the meaning of the
 training word (of ``PGAE-BERT-phrasings-held-out``'s lexicon) whose vector is
 closest by cosine. A held-out word that lands nearest another meaning is one the
 encoder does not place with its meaning, so a read-out trained on the other words
@@ -18,7 +18,7 @@ import argparse
 
 import torch
 
-from pgae_lite.bert.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
+from pgae_lite.freeform.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
 from pgae_lite.bert.pretrained import load_transformer
 
 CARRIERS = {"action": "{} the red cube slowly", "colour": "push the {} cube slowly",

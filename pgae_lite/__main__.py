@@ -32,7 +32,7 @@ FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned", "PTAE")
 def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
     """Record the profile's simulated dataset (or complete it) and print what was done."""
     from pgae_lite.config import get_profile
-    from pgae_lite.data.simulated import generate
+    from pgae_lite.sim.dataset import generate
 
     report = generate(get_profile(profile).data, workers=workers, progress=progress)
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "

@@ -1,7 +1,7 @@
 """The recipes: the ``book`` profile, the paper's (paper Sec. 4, "Training Details") and ``smoke``.
 
 A profile is a whole run, composed of each part's own settings, each defined beside what it
-configures: what to record (:class:`~pgae_lite.data.simulated.DatasetConfig`), the CAE
+configures: what to record (:class:`~pgae_lite.sim.dataset.DatasetConfig`), the CAE
 (:class:`~pgae_lite.cae.CAEConfig`), the model (:class:`~pgae_lite.model.config.ModelConfig`),
 its training (:class:`~pgae_lite.train.config.TrainConfig`) and how much the chapters do
 (:class:`ChapterSettings`). The defaults of those settings are the ``book`` recipe; the paper's
@@ -9,31 +9,34 @@ profile is the book's with one override per line, each beside the paper section 
 
 A profile's name is resolved into a :class:`Profile` once, where a run starts (the command
 line, a chapter, a benchmark): :func:`get_profile`. Below that, functions take ``Profile``
-values. The environment variable ``PGAE_LITE_PROFILE`` picks the default profile;
-:func:`profile_name` is the only code that reads it.
-
-Table 1's rows (:data:`ROWS`) and the family's beside them (:data:`FAMILY_ROWS`) are trainings
-(:data:`TRAININGS`): what each changes in a profile (:func:`training_profile`). Trainings that
-are not rows are built where they are used (:mod:`pgae_lite.runs.trainings`).
+values, and no behaviour depends on a profile's name. The environment variable
+``PGAE_LITE_PROFILE`` picks the default profile; :func:`profile_name` is the only code that reads it.
+The trainings of Table 1's rows and of the family's are values too, beside the code that runs
+them (:mod:`pgae_lite.runs.rows`). :func:`recipe_from_dict` reads a recipe a checkpoint saved.
 """
 from __future__ import annotations
 
 import os
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
+from pgae_lite.bert.config import PretrainedConfig
 from pgae_lite.cae import CAEConfig
-from pgae_lite.data.simulated import DatasetConfig
-from pgae_lite.model.config import ModelConfig
-from pgae_lite.train.config import RECIPE_VERSION, TrainConfig
+from pgae_lite.freeform.attention_pooling import AttentionConfig
+from pgae_lite.freeform.phrasing_bank import PhrasingsConfig
+from pgae_lite.model.config import PARTS, ModelConfig
+from pgae_lite.model.prae import BindingConfig
+from pgae_lite.model.ptae import CrossmodalConfig
+from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.train.config import RECIPE_VERSION, TRAIN_PARTS, TrainConfig
+from pgae_lite.train.supervision import SupervisionConfig
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.patterns import pattern_number
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
-#: ModelConfig's options of PTAE's transformer, and TrainConfig's of limited supervision: a recipe's dict
-#: (Profile.to_dict) leaves them out where they are unused, so the models cached and checkpointed before
-#: they existed keep their digests and their resume (a missing option reads as its default).
-TRANSFORMER_OPTIONS = ("bottleneck", "heads", "feedforward", "dropout", "frame_positions")
 PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
+#: Every part a recipe may hold, by the kind its dict names (recipe_from_dict).
+PART_KINDS = {c.kind: c for c in (PretrainedConfig, AttentionConfig, CrossmodalConfig, BindingConfig,
+                                  SupervisionConfig, PhrasingsConfig)}
 
 
 @dataclass(frozen=True)
@@ -48,7 +51,10 @@ class ChapterSettings:
 
 @dataclass
 class Profile:
-    """A named run: data, CAE, model, training and the chapters' settings (defaults: the ``book`` profile's)."""
+    """A named run: data, CAE, model, training and the chapters' settings (defaults: the ``book`` profile's).
+
+    ``authors_recipes``: every model trains with its own authors' settings where its training names them
+    (the ``paper`` profile: :class:`pgae_lite.runs.rows.Training`); else with this profile's."""
 
     name: str
     model: ModelConfig = field(default_factory=ModelConfig)
@@ -58,22 +64,15 @@ class Profile:
     # place of 10,000 of batch 200 (hours): at equal compute, smaller batches did better (A2).
     cae: CAEConfig = CAEConfig("book", batch_size=16, iterations=1000, frame_stride=10)
     chapters: ChapterSettings = ChapterSettings()
+    authors_recipes: bool = False
 
     def to_dict(self) -> dict:
-        """The recipe of the PGAE model: saved in its checkpoints and hashed into its cache key.
-
-        Data and CAE are not in it (their own cache keys name them), nor the chapters' settings.
-        ``recipe_version`` (:data:`~pgae_lite.train.config.RECIPE_VERSION`) says which meaning
-        of these options a checkpoint was trained with.
+        """The recipe of the model: every setting of its model and its training, saved in its checkpoints
+        and hashed into its cache key. Not the name (the values are the recipe), not the data and the CAE
+        (their own cache keys name them), nor the chapters' settings. ``recipe_version``
+        (:data:`~pgae_lite.train.config.RECIPE_VERSION`) says which meaning of these options it was trained with.
         """
-        model, train = asdict(self.model), asdict(self.train)
-        if model["bottleneck"] == "gmu":        # the transformer's settings mean nothing to a GMU
-            for key in TRANSFORMER_OPTIONS:
-                model.pop(key)
-        for key in ("paired_share", "labelled_share"):
-            if train[key] is None:              # full supervision: the recipe as it was
-                train.pop(key)
-        return {"name": self.name, "recipe_version": RECIPE_VERSION, "model": model, "train": train}
+        return {"recipe_version": RECIPE_VERSION, "model": self.model.to_dict(), "train": self.train.to_dict()}
 
 
 # --------------------------------------------------------------------------- the recipes
@@ -112,6 +111,7 @@ PAPER = replace(
     ),
     cae=CAEConfig("paper"),           # Sec. 3, Visual Feature Extraction: the authors' CAE training
     chapters=ChapterSettings(runs_per_action=6),
+    authors_recipes=True,             # PRAE, PVAE, PTAE: their own papers' settings (runs/rows.py)
 )
 
 #: Two arrangements (0: red+blue, 7: cyan+yellow), every action at both speeds;
@@ -155,72 +155,35 @@ def get_profile(name: Profile | str | None = None, **train_overrides) -> Profile
     Keyword arguments override fields of its :class:`~pgae_lite.train.config.TrainConfig`, e.g. ``seed=1``.
     """
     p = name if isinstance(name, Profile) else PROFILES[profile_name(name)]
-    bad = set(train_overrides) - set(asdict(p.train))
+    options = [f.name for f in fields(p.train)]
+    bad = set(train_overrides) - set(options)
     if bad:
         raise ArgumentError(f"unknown training option(s) {sorted(bad)}; the options "
-                            f"are: {', '.join(asdict(p.train))}")
+                            f"are: {', '.join(options)}")
     return replace(p, model=replace(p.model), train=replace(p.train, **train_overrides))
 
 
-# --------------------------------------------------------------------------- Table 1's trainings
-@dataclass(frozen=True)
-class Training:
-    """One training: its name (its cache folder's) and what it changes in a profile's recipe."""
-
-    name: str
-    model: dict = field(default_factory=dict)
-    train: dict = field(default_factory=dict)
-    # the model's own authors' settings, over the ``paper`` profile (PGAE's paper's) only
-    paper_model: dict = field(default_factory=dict)
-    paper_train: dict = field(default_factory=dict)
+def with_world(profile: Profile, world) -> Profile:
+    """``profile`` in a world beyond the paper's (:func:`pgae_lite.world.colours.with_colour`, appendix A3): its
+    data records the world's patterns (the paper's recordings, then the world's own) and its model reads and
+    writes the world's words. The one pipeline does the rest (:mod:`pgae_lite.runs.pipeline`)."""
+    return replace(profile, data=replace(profile.data, world=world))
 
 
-#: The trainings of Table 1's rows and of the family's (PTAE), by name.
-TRAININGS: dict[str, Training] = {t.name: t for t in (
-    Training("PGAE"),
-    Training("PGAE-BERT", model={"language_encoder": "pretrained"}),
-    # Authors' code: the opposite agent's view with probability 1/2 (describe and the repeat signals).
-    Training("PGAE-views", train={"opposite_prob": 0.5}),
-    # PTAE (model/ptae.py): the crossmodal transformer in place of the GMU, 128 wide in the book. Its paper's
-    # model: 256 wide, feed-forward 1024, dropout 0.25, frames without positions; its training: Adam 1e-5,
-    # batch 6, 2,500 epochs. Deviation from paper: at a constant rate (theirs decays in steps).
-    Training("PTAE", model={"bottleneck": "crossmodal-transformer", "hidden": 128},
-             paper_model={"hidden": 256, "feedforward": 1024, "dropout": 0.25, "frame_positions": False},
-             paper_train={"epochs": 2500}),
-)}
-#: row -> (training, evaluated on the opposite agent's actions?)
-ROWS: dict[str, tuple[str, bool]] = {
-    "PGAE": ("PGAE", False),
-    "PGAE-BERT": ("PGAE-BERT", False),
-    "PGAE-self": ("PGAE-views", False),
-    "PGAE-opposite": ("PGAE-views", True),
-}
-#: The family's rows beside Table 1's (not in PGAE's Table 1; benchmarks/family.py's table): ``reproduce
-#: --rows`` takes them by name, ``--rows all`` means Table 1's.
-FAMILY_ROWS: dict[str, tuple[str, bool]] = {"PRAE": ("PRAE", False), "PVAE": ("PVAE", False),
-                                             "PVAE-BERT": ("PVAE-BERT", False),
-                                             "PVAE-BERT-tuned": ("PVAE-BERT-tuned", False), "PTAE": ("PTAE", False)}
-#: The family's rows configured per direction: trained by pgae_lite.family.train, not as a Training.
-CONFIGURED_ROWS = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned")
-EVERY_ROW: dict[str, tuple[str, bool]] = {**ROWS, **FAMILY_ROWS}
+def _with_parts(settings: dict, parts: tuple[str, ...], where: str) -> dict:
+    """A saved config's dict with each part's dict made its part again (by its kind)."""
+    out = dict(settings)
+    for name in parts:
+        if out.get(name) is not None:
+            part = dict(out[name])
+            kind = part.pop("kind", None)
+            if kind not in PART_KINDS:
+                raise ValueError(f"{where}: unknown part {name}={kind!r}; the parts are: {', '.join(PART_KINDS)}")
+            out[name] = PART_KINDS[kind](**part)
+    return out
 
 
-def as_training(training: Training | str) -> Training:
-    """A :class:`Training`: itself, or one of Table 1's by name (:data:`TRAININGS`)."""
-    if isinstance(training, Training):
-        return training
-    if training not in TRAININGS:
-        raise ArgumentError(f"unknown training {training!r}; the rows' trainings are: {', '.join(TRAININGS)}; "
-                            f"the others are Training values (pgae_lite.runs.trainings)")
-    return TRAININGS[training]
-
-
-def training_profile(base: Profile, training: Training | str, pretrained_model: str | None = None) -> Profile:
-    """``base`` with one training's changes (and the pretrained model's name, for a pretrained encoder)."""
-    t = as_training(training)
-    paper = base.name == "paper"                       # the model's own authors' settings over the paper profile
-    model = replace(base.model, **{**t.model, **(t.paper_model if paper else {})})
-    if pretrained_model and model.language_encoder != "lstm":
-        model = replace(model, pretrained_model=pretrained_model)
-    train = replace(base.train, **{**t.train, **(t.paper_train if paper else {})})
-    return replace(base, model=model, train=train)
+def recipe_from_dict(recipe: dict) -> tuple[ModelConfig, TrainConfig]:
+    """The model's and the training's settings of a recipe saved as :meth:`Profile.to_dict` wrote it."""
+    model = ModelConfig(**_with_parts(recipe["model"], PARTS, "the model's settings"))
+    return model, TrainConfig(**_with_parts(recipe["train"], TRAIN_PARTS, "the training's settings"))

@@ -96,7 +96,7 @@ def _private_cache(tmp_path_factory):
 def smoke_episodes(_private_cache):
     """The smoke profile's simulated dataset (24 episodes), recorded once per session."""
     from pgae_lite.config import get_profile
-    from pgae_lite.data.simulated import generate
+    from pgae_lite.sim.dataset import generate
 
     config = get_profile("smoke").data
     return config, generate(config, progress=False)

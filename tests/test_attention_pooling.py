@@ -1,4 +1,4 @@
-"""pgae_lite.bert.attention_pooling: trained attention over the frozen transformer's tokens, real encoder."""
+"""pgae_lite.freeform.attention_pooling: trained attention over the frozen transformer's tokens, real encoder."""
 from __future__ import annotations
 
 import importlib.util
@@ -9,12 +9,12 @@ import pytest
 import torch
 
 from pgae_lite.bert.encoders import build_pgae
-from pgae_lite.bert.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
+from pgae_lite.freeform.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.world.words import SIGNALS
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.bert.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
-from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
 from pgae_lite.model.signals import make_batch
 from pgae_lite.train.checkpoint import load_checkpoint

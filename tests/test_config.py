@@ -14,7 +14,7 @@ from pgae_lite.config import (
     get_profile,
     profile_name,
 )
-from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.sim.dataset import DatasetConfig
 
 UNKNOWN = "unknown profile 'garbage'; the profiles are: smoke, book, paper"
 

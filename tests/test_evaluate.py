@@ -1,4 +1,4 @@
-"""pgae_lite.evaluate: nRMSE, prediction conventions, Table 1."""
+"""pgae_lite.evaluate.table1: nRMSE, prediction conventions, Table 1."""
 from __future__ import annotations
 
 import math
@@ -9,7 +9,7 @@ import torch
 
 from pgae_lite.config import ModelConfig
 from pgae_lite.data.dataset import Normaliser
-from pgae_lite.evaluate import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
+from pgae_lite.evaluate.table1 import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import TEST_SIGNALS, WORD_INDEX

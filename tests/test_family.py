@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.family.binding import binding_loss
+from pgae_lite.model.binding import binding_loss
 from pgae_lite.util.errors import ArgumentError
 
 
@@ -73,14 +73,14 @@ def prae_inputs(tensors, index, alternative=None):
 
     if alternative is None:
         alternative = torch.zeros(len(index), dtype=torch.long)
-    from pgae_lite.family.prae import paired_inputs
+    from pgae_lite.model.prae import paired_inputs
 
     b = make_batch(tensors, index, signal_ids("repeat both", len(index)), alternative)
     return paired_inputs(b), b
 
 
 def test_prae_rebuilds_each_modality_from_its_code_and_translates_only_across(toy_tensors):
-    from pgae_lite.family.prae import PRAE
+    from pgae_lite.model.prae import PRAE
     from pgae_lite.model.config import ModelConfig
 
     model = PRAE(ModelConfig(units=16))
@@ -95,7 +95,7 @@ def test_prae_rebuilds_each_modality_from_its_code_and_translates_only_across(to
 
 def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(toy_short):
     from pgae_lite.data.dataset import Normaliser
-    from pgae_lite.family.prae import PRAE
+    from pgae_lite.model.prae import PRAE
     from pgae_lite.model.config import ModelConfig
 
     torch.manual_seed(0)
@@ -145,7 +145,7 @@ def check_the_configured_cells(model, data, tensors):
 
 # ------------------------------------------------------------------ PVAE
 def test_the_kl_term_is_its_equation_and_torchs():
-    from pgae_lite.family.pvae import kl_divergence
+    from pgae_lite.model.pvae import kl_divergence
 
     torch.manual_seed(2)
     mean, log_var = torch.randn(3, 4, dtype=torch.float64), torch.randn(3, 4, dtype=torch.float64)
@@ -159,7 +159,7 @@ def test_the_kl_term_is_its_equation_and_torchs():
 
 
 def test_a_pvae_sample_is_the_mean_with_the_authors_small_noise():
-    from pgae_lite.family.pvae import PVAE, SAMPLING_STD
+    from pgae_lite.model.pvae import PVAE, SAMPLING_STD
 
     torch.manual_seed(3)
     mean = torch.full((20_000, 2), 5.0)
@@ -172,7 +172,7 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
     """Every step draws one of the 8 equivalent descriptions of each action; the cross path then
     describes each action with one of its 8 (the one-to-many translation PRAE was not made for)."""
     from pgae_lite.data.dataset import Normaliser
-    from pgae_lite.family.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
+    from pgae_lite.model.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
     from pgae_lite.model.config import ModelConfig
 
     torch.manual_seed(0)
@@ -225,7 +225,7 @@ def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(t
     """The row as its text, looked up in the encoder's table; the encoder's weights never train."""
     from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, tokens_to_text
     from pgae_lite.data.dataset import Normaliser
-    from pgae_lite.family.pvae import PVAE
+    from pgae_lite.model.pvae import PVAE
     from pgae_lite.family.train import train_family
     from pgae_lite.model.config import ModelConfig
     from pgae_lite.train.config import TrainConfig
@@ -260,8 +260,8 @@ def test_pvae_bert_tuned_trains_its_top_layer_and_nothing_below(toy_short):
 
 # ------------------------------------------------------------------ the chapter's models and tables
 def test_family_models_trains_the_chapters_three_and_ptae_is_cached():
-    from pgae_lite.family.pvae import PVAE
-    from pgae_lite.family.prae import PRAE
+    from pgae_lite.model.pvae import PVAE
+    from pgae_lite.model.prae import PRAE
     from pgae_lite.model.ptae import PTAE
     from pgae_lite.runs.family_models import family_models
 

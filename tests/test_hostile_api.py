@@ -24,7 +24,7 @@ import pgae_lite
 from pgae_lite.config import PROFILE_ENV, get_profile, profile_name
 from pgae_lite.data.dataset import Normaliser
 from pgae_lite.util.errors import ArgumentError, ArgumentTypeError, PGAELiteError
-from pgae_lite.evaluate import Predictions, evaluate, format_table, nrmse, predict
+from pgae_lite.evaluate.table1 import Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.config import ModelConfig
 from pgae_lite.robot.instructions import instruction_features
 from pgae_lite.world.words import (BOS_EOS, SLOTS, SYNONYMS, VOCABULARY, LanguageError,

@@ -32,7 +32,7 @@ from pgae_lite.cae import load_cae
 from pgae_lite.config import TrainConfig, get_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.data.original import load_original
-from pgae_lite.data.simulated import CorruptEpisodeError, episode_folder, generate, load_episode_file
+from pgae_lite.sim.dataset import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs import pipeline
 from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint, load_model

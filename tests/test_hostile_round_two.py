@@ -46,8 +46,8 @@ def test_reproduce_refuses_a_planted_link_and_a_file_for_its_folder(tmp_path, or
 @pytest.fixture(scope="module")
 def lookup():
     pytest.importorskip("wn")
-    from pgae_lite.bert.phrase_lexicon import training_lexicon
-    from pgae_lite.bert.word_lookup import WordLookup
+    from pgae_lite.freeform.phrase_lexicon import training_lexicon
+    from pgae_lite.freeform.word_lookup import WordLookup
 
     return WordLookup(training_lexicon("held-out"))
 

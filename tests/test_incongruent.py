@@ -1,10 +1,10 @@
-"""Incongruent input (pgae_lite/runs/incongruent.py): the swaps are what they say, and the measures are Table 1's."""
+"""Incongruent input (pgae_lite/evaluate/incongruent.py): the swaps are what they say, and the measures are Table 1's."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from pgae_lite.runs.incongruent import joint_nrmse, meanings, shown_instead, swapped_words
+from pgae_lite.evaluate.incongruent import joint_nrmse, meanings, shown_instead, swapped_words
 from pgae_lite.world.patterns import pattern_parts
 from pgae_lite.world.words import CANONICAL, VOCABULARY, WORD_INDEX
 
@@ -38,7 +38,7 @@ def test_the_recording_shown_differs_from_the_sample_by_its_kind_alone(toy, kind
 
 
 def test_the_joint_error_is_table_1s(toy_tensors, toy):
-    from pgae_lite.evaluate import Predictions, nrmse
+    from pgae_lite.evaluate.table1 import Predictions, nrmse
 
     rng = np.random.default_rng(1)
     target = toy.joints[:10]

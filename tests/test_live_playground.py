@@ -135,7 +135,7 @@ TYPED = ["slide the amethyst cube aside", "Drag the CRIMSON block toward you has
 
 
 def _texts() -> list[str]:
-    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.freeform.paraphrases import load_paraphrases
 
     return [p.text for p in load_paraphrases()] + TYPED
 
@@ -160,8 +160,8 @@ def test_free_text_in_the_page_is_what_pytorch_computes(page, name):
     what the page writes and says back is PyTorch's, the text is read as Python reads it, the joints are
     within 1e-3 of the joint range (the page's transformer has float16 weights), and a text Python's
     refusal refuses is refused with its sentence."""
-    from pgae_lite.bert.paraphrases import load_paraphrases
-    from pgae_lite.robot.refusals import refusal
+    from pgae_lite.freeform.paraphrases import load_paraphrases
+    from pgae_lite.freeform.refusals import refusal
     from pgae_lite.web.sentence import free_text_reference
 
     pg, errors = page
@@ -284,8 +284,8 @@ INSTRUCTIONS = ["don't push the red cube", "please never pull the blue block", "
 @pytest.mark.parametrize("name", FREE_MODELS)
 def test_the_page_refuses_what_python_refuses(page, name):
     """Under execute, free text gets the sentence Python's refusal gives (CannotDo), or acts with its note."""
-    from pgae_lite.bert.paraphrases import load_paraphrases
-    from pgae_lite.robot.refusals import disagreement, refusal
+    from pgae_lite.freeform.paraphrases import load_paraphrases
+    from pgae_lite.freeform.refusals import disagreement, refusal
     from pgae_lite.web.sentence import free_text_reference
 
     pg, errors = page

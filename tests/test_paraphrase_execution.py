@@ -14,10 +14,10 @@ import torch
 from pgae_lite.robot.closedloop import closed_loop, success_summary
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import description_text
-from pgae_lite.evaluate import predict
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.robot.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
 from pgae_lite.world.words import LanguageError
-from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
 from pgae_lite.train.loop import train

@@ -1,4 +1,4 @@
-"""pgae_lite.bert.phrasing_bank: PGAE-BERT trained on generated phrasings, with the real encoder."""
+"""pgae_lite.freeform.phrasing_bank: PGAE-BERT trained on generated phrasings, with the real encoder."""
 from __future__ import annotations
 
 import importlib.util
@@ -12,8 +12,8 @@ from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
 from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.bert.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
-from pgae_lite.bert.phrasings import phrasings
+from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.train.loop import train

@@ -87,7 +87,7 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
 def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(monkeypatch):
     from dataclasses import replace
 
-    import pgae_lite.bert.phrase_lexicon as phrase_lexicon
+    import pgae_lite.freeform.phrase_lexicon as phrase_lexicon
     from pgae_lite.config import training_profile
     from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.util.storage import config_digest

@@ -18,17 +18,17 @@ from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
 from pgae_lite.robot.closedloop import pattern_for
 from pgae_lite.data.dataset import Normaliser
-from pgae_lite.evaluate import predict
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.robot.instructions import acted_on, instruction_features
 from pgae_lite.world.words import VOCABULARY, LanguageError
 from pgae_lite.config import ModelConfig
 from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_parts
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.bert.phrase_lexicon import LEXICON
+from pgae_lite.freeform.phrase_lexicon import LEXICON
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.robot.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
                                   find_episode, pattern_number, play)
-from pgae_lite.bert.word_lookup import WordLookup
+from pgae_lite.freeform.word_lookup import WordLookup
 
 ARRANGEMENT, ACTION = 7, 8              # cyan left, yellow right; slide the left cube fast: pattern 116
 PATTERN = 116

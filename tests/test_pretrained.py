@@ -15,7 +15,7 @@ import torch
 
 from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate import predict
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
 from pgae_lite.config import ModelConfig
 from pgae_lite.model.pgae import PGAE

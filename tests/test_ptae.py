@@ -85,7 +85,7 @@ def test_positional_encoding_is_the_transformers_sinusoids():
 
 def test_ptae_trains_in_pgaes_loop_learns_and_loads_from_its_checkpoint(toy_short, tmp_path):
     from pgae_lite.config import get_profile, training_profile
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.model.ptae import PTAE
     from pgae_lite.train.checkpoint import load_model
     from pgae_lite.train.loop import train

@@ -1,6 +1,6 @@
 """The robot says what it cannot do: free text it will not act on is refused, with the reason.
 
-The rule (pgae_lite/robot/refusals.py) reads the words through the training lexicon and WordNet, the
+The rule (pgae_lite/freeform/refusals.py) reads the words through the training lexicon and WordNet, the
 scene and the model's readback. The first tests need no model (an encoder without a word lookup reads
 the words through the training lexicon); the last ones use PGAE-BERT trained on the smoke profile.
 The measured shares, on a generated set, are benchmarks/refusals.py's.
@@ -12,15 +12,15 @@ import itertools
 
 import pytest
 
-from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
-from pgae_lite.bert.phrase_lexicon import training_lexicon
-from pgae_lite.bert.phrasings import phrasings
-from pgae_lite.bert.word_lookup import WordLookup
+from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.freeform.phrase_lexicon import training_lexicon
+from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.freeform.word_lookup import WordLookup
 from pgae_lite.config import get_profile
 from pgae_lite.robot.closedloop import closed_loop
 from pgae_lite.robot.instructions import execute_paraphrases
 from pgae_lite.robot.playground import play
-from pgae_lite.robot.refusals import CannotDo, check_instruction, disagreement, refusal
+from pgae_lite.freeform.refusals import CannotDo, check_instruction, disagreement, refusal
 from pgae_lite.world.patterns import ARRANGEMENTS, Pattern
 from pgae_lite.world.words import COLOURS, LanguageError
 

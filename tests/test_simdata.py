@@ -1,4 +1,4 @@
-"""pgae_lite.data.simulated and pgae_lite.runs.pipeline: the cache of simulated episodes, features, the dataset."""
+"""pgae_lite.sim.dataset and pgae_lite.runs.pipeline: the cache of simulated episodes, features, the dataset."""
 from __future__ import annotations
 
 import numpy as np
@@ -6,7 +6,7 @@ import pytest
 
 from pgae_lite.config import SMOKE_PATTERNS
 from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.data.simulated import (
+from pgae_lite.sim.dataset import (
     CorruptEpisodeError,
     DatasetConfig,
     episode_folder,

@@ -17,7 +17,7 @@ def train_unit(seed: int) -> dict:
 
     from pgae_lite.config import get_profile
     from pgae_lite.data.toy import toy_dataset
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)
@@ -70,7 +70,7 @@ def resumable_unit(seed: int, folder: str) -> dict:
 
     from pgae_lite.config import get_profile
     from pgae_lite.data.toy import toy_dataset
-    from pgae_lite.evaluate import evaluate
+    from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)

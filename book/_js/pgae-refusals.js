@@ -1,5 +1,5 @@
 // What the robot will not do with a free instruction, and says instead, in the reader's page
-// (not in the paper). The rule of pgae_lite/robot/refusals.py, line for line, on the data the
+// (not in the paper). The rule of pgae_lite/freeform/refusals.py, line for line, on the data the
 // build writes for it (pgae_lite/web/refusal_data.py): the phrase lexicon's tables, and WordNet's
 // colour words and verbs. pgae.js loads this file with the sentence encoder, on the first free
 // text, and calls window.pgaeRefusals.make(shared, pyrepr) once:

@@ -22,7 +22,7 @@
 // top layer and the model's head, its own top layer and pooling (pgae_lite/web/sentence.py),
 // after the variant's word lookup read from its table (pgae_lite/web/word_table.py). Those files
 // are fetched on the first free text only (their bytes: results/live_playground.json). Under execute, free text the robot will not act on (a negation, two instructions, a
-// cube that is not there: pgae_lite/robot/refusals.py) rejects with Python's sentence
+// cube that is not there: pgae_lite/freeform/refusals.py) rejects with Python's sentence
 // (pgae-refusals.js), and the result's note says where the readback and the episode disagree.
 //
 //   window.pgae.readAs(model, text) -> Promise of the text as the model reads it (the variant's lookup).
@@ -195,7 +195,7 @@
     return refusalRules[name];
   }
 
-  // The words of a text, as pgae_lite.bert.word_lookup splits them: letters, inner apostrophes.
+  // The words of a text, as pgae_lite.freeform.word_lookup splits them: letters, inner apostrophes.
   const WORD = /[\p{L}\p{Nl}\p{No}]+(?:'[\p{L}\p{Nl}\p{No}]+)*/gu;
 
   // The text as a model's encoder reads it (encoder.read_as): the variant's unknown words replaced.

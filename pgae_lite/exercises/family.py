@@ -1,7 +1,7 @@
 """Checks of the family chapter's exercises: the binding loss of PRAE and PVAE (PGAE paper, Sec. 2).
 
 ``check_binding_loss(my_binding_loss)`` runs the student's loss next to
-:func:`pgae_lite.family.binding.binding_loss` on seeded random codes, at several margins, and
+:func:`pgae_lite.model.binding.binding_loss` on seeded random codes, at several margins, and
 names a known mistake when one reproduces the student's numbers (chapter 09).
 """
 from __future__ import annotations
@@ -11,7 +11,7 @@ from typing import Callable
 import torch
 
 from pgae_lite.exercises.result import RAISED, CheckResult, _call, _compare
-from pgae_lite.family.binding import binding_loss
+from pgae_lite.model.binding import binding_loss
 from pgae_lite.util.checks import MAX_SEED, whole_number
 
 BINDING_EQUATION = ("L = mean_i D[i,i] + 1/B² Σ_{i≠j} [max(0, m + D[j,j] − D[i,j]) + max(0, m + D[i,i] − D[i,j])], "

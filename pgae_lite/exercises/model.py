@@ -26,7 +26,7 @@ from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell
 from pgae_lite.model.pgae import PGAE, count_parameters
 from pgae_lite.model.signals import SIGNAL_PROBS, make_batch, sample_signals
 from pgae_lite.data.toy import toy_dataset
-from pgae_lite.train.loss import pgae_loss
+from pgae_lite.model.loss import pgae_loss
 from pgae_lite.util.checks import MAX_SEED, whole_number
 from pgae_lite.exercises.result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
                      _pair, _shape, _unchanged, _value_problem)

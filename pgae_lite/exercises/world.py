@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.evaluate import nrmse, predict
+from pgae_lite.evaluate.table1 import nrmse, predict
 from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
 from pgae_lite.world.colours import MIN_COLOUR_DIFFERENCE, World, nearest_seen
 from pgae_lite.exercises.result import RAISED, CheckResult, _call, _numbers
@@ -104,7 +104,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
 
     The held-out episodes are the test patterns of the new arrangements (a cube of
     ``colour`` on the table; :func:`pgae_lite.world.colours.with_colour` chose them). Passing
-    needs both, measured as in Table 1 (:mod:`pgae_lite.evaluate`):
+    needs both, measured as in Table 1 (:mod:`pgae_lite.evaluate.table1`):
 
     - describe: at least ``min_accuracy`` % (75) right descriptions of the episodes that
       move the ``colour`` cube. A model without the word scores 0%, one that names
@@ -122,7 +122,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
     if lexicon is None or colour not in lexicon.colours:
         return result.fail(f"the model's vocabulary has no colour {colour!r}",
                            "build the model for the new world: "
-                           "PGAE(cfg, lexicon=world.lexicon), as extended.trained_pgae")
+                           "train it in the world's profile, pgae_lite.config.with_world(profile, world)")
     result.ok(f"the model reads and writes {lexicon.size} words, {colour!r} and "
               f"{lexicon.synonym[colour]!r} among them")
     with_colour = np.array([colour in str(a).split("+") for a in dataset.arrangement])
@@ -130,7 +130,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
     if not held.any():
         return result.fail(f"the dataset has no held-out episodes with a {colour} cube",
                            "record the new patterns and build the data with "
-                           "pgae_lite.runs.new_colour.extended_dataset(world)")
+                           "pgae_lite.runs.pipeline.simulated_dataset(with_world(profile, world))")
     if int(dataset.descriptions.max()) >= lexicon.size:
         return result.fail(f"the dataset has word indices up to "
                            f"{int(dataset.descriptions.max())}, beyond the model's "

@@ -1,40 +1,65 @@
-"""PGAE's architecture settings, :class:`ModelConfig` (paper Sec. 3; sizes from the authors' code).
+"""The models' architecture settings, :class:`ModelConfig` (paper Sec. 3; sizes from the authors' code).
 
-The defaults are the ``book`` recipe; the paper's own settings are the ``paper`` profile in
-:mod:`pgae_lite.config`, written as the book recipe with one override per line. Every departure
-is marked ``# Deviation from paper:`` here; what it measured to is on the book's results page
-(appendix A2), not in these comments.
+``ModelConfig`` holds what every model of the book reads: its LSTMs, the size of its shared
+representation, its action decoder's feedback and time stride, and the two options of the paper's
+bottleneck and plan head. What only some models read lives in a part beside their code, ``None`` in
+the plain recipe (PGAE):
+
+    language    a pretrained language encoder in place of the LSTM over one-hot words:
+                PGAE-BERT's (:class:`pgae_lite.bert.pretrained.PretrainedConfig`) or the free-form
+                variant's (:class:`pgae_lite.freeform.attention_pooling.AttentionConfig`)
+    crossmodal  PTAE's crossmodal transformer in place of the GMU (:class:`pgae_lite.model.ptae.CrossmodalConfig`)
+    binding     PRAE's and PVAE's two autoencoders bound by a loss (:class:`pgae_lite.model.prae.BindingConfig`)
+
+Every part is a :class:`Part`: frozen, checked where it is made, written into a recipe's dict with
+its ``kind``. The defaults are the ``book`` recipe; the paper's own settings are the ``paper``
+profile in :mod:`pgae_lite.config`. Every departure is marked ``# Deviation from paper:`` here;
+what it measured to is on the book's results page (appendix A2), not in these comments.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, fields
+from typing import ClassVar
 
-#: The language encoders a ModelConfig may name: the paper's LSTM (PGAE), the frozen pretrained
-#: transformer (PGAE-BERT), and the transformer read through a trained attention pooling (not in the paper).
-LANGUAGE_ENCODERS = ("lstm", "pretrained", "pretrained-attention")
 CELLS = ("lstm", "peephole")
 JOINT_FEEDBACKS = ("start", "predicted")
-#: What joins the two modalities into h: PGAE's Gated Multimodal Unit, or PTAE's crossmodal transformer
-#: (the words and signal attend to the action frames; pgae_lite.model.ptae).
-BOTTLENECKS = ("gmu", "crossmodal-transformer")
+#: The optional parts of a ModelConfig, each None or a Part.
+PARTS = ("language", "crossmodal", "binding")
 
 
-def _whole(name: str, value, low: int, meaning: str = "") -> None:
+def whole(owner: str, name: str, value, low: int, meaning: str = "") -> None:
     """A ValueError unless ``value`` is a whole number >= ``low`` (``meaning``: what a value means)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < low:
-        raise ValueError(f"ModelConfig {name} must be a whole number >= {low}{meaning}; got {value!r}")
+        raise ValueError(f"{owner} {name} must be a whole number >= {low}{meaning}; got {value!r}")
+
+
+def flag(owner: str, name: str, value) -> None:
+    """A ValueError unless ``value`` is True or False."""
+    if not isinstance(value, bool):
+        raise ValueError(f"{owner} {name} must be True or False; got {value!r}")
+
+
+@dataclass(frozen=True)
+class Part:
+    """An optional part of a recipe, beside the code that reads it: its ``kind`` names it in a recipe's dict."""
+
+    kind: ClassVar[str] = "part"
+
+    def check(self, owner) -> None:
+        """Raise a ValueError if this part cannot go with the rest of ``owner`` (the config holding it)."""
+
+    def to_dict(self) -> dict:
+        return {"kind": self.kind, **asdict(self)}
 
 
 @dataclass
 class ModelConfig:
-    """Architecture of PGAE (:class:`pgae_lite.model.pgae.PGAE`). Defaults are the ``book`` recipe.
-
-    Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50.
-    """
+    """Architecture of PGAE and its family (:func:`pgae_lite.model.build.build_model`). Defaults: the
+    ``book`` recipe's PGAE. Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50."""
 
     units: int = 100
     layers: int = 2
-    hidden: int = 50
+    hidden: int = 50     # h: the GMU's output (PGAE), the transformer's width (PTAE), each code (PRAE, PVAE)
     cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
     # Deviation from paper: "start" = the action decoder reads the start joints at every step instead of
     # its own previous prediction ("predicted", the paper's; see pgae.ActionDecoder).
@@ -43,75 +68,50 @@ class ModelConfig:
     # step, the decoder reads every 3rd frame and writes the next 3 poses, every pose (paper: 1). A third of
     # the LSTM steps per sample, with Table 1 kept; stride 4 lost joint precision (experiments/HISTORY.md).
     time_stride: int = 3
-    # "lstm" = PGAE's language encoder; "pretrained" = PGAE-BERT's frozen transformer (bert/pretrained.py);
-    # "pretrained-attention" = the same transformer with a trained attention pooling (bert/attention_pooling.py).
-    language_encoder: str = "lstm"
-    pretrained_model: str | None = None   # Hugging Face name or folder; None = the default shipped model
-    # Not in the paper (which keeps the transformer frozen): with "pretrained-attention", free text reads
-    # the transformer's top layer trained (bert/tuned_layer.py); the 869 fixed inputs stay frozen. With
-    # "pretrained", every input reads it, mean-pooled: PVAE-BERT's fine-tuning, at the top layer
-    # (bert/tuned_encoder.py).
-    tuned_top_layer: bool = False
     # Deviation from paper: the GMU layer-normalises W_A f_act + b before its tanh (layers.GatedMultimodalUnit;
     # paper: no normalisation). Without it, on some seeds the unbounded cell states in f_act saturate A_h for
     # every sample early in training, and describe never learns: one sentence for every action
-    # (experiments/HISTORY.md, "The describe collapse").
+    # (experiments/HISTORY.md, "The describe collapse"). Read by the GMU only.
     gmu_norm: bool = True
     # Deviation from paper: a plan head reads h and predicts this many keyframes of the motion in training
     # (plan.PlanHead; 0 = none, the paper's). It makes h carry which cube the words mean in this scene, which
     # the recorded frames otherwise tell the decoder: without it the closed loop mostly moves the other cube.
+    # PRAE and PVAE have none (their recipes set 0).
     plan_keyframes: int = 10
-    # "gmu" = PGAE; "crossmodal-transformer" = PTAE (model/ptae.py): the tokens and the frames enter one
-    # transformer layer of ``heads`` heads and a feed-forward of ``feedforward`` units, whose width is
-    # ``hidden``. The book's PTAE is 128 wide (config.TRAININGS); PTAE's authors: 4 heads, 256, 1024, 0.25.
-    bottleneck: str = "gmu"
-    heads: int = 4
-    # Deviation from paper: a feed-forward of 512 (PTAE: 1024), no dropout (PTAE: 0.25), and the frames read
-    # with their positions (PTAE: none; push and pull visit the same poses in opposite orders). Each change
-    # and what it did on the authors' data: benchmarks/ptae_recipe.py (results/ptae_recipe.json, A2).
-    feedforward: int = 512
-    dropout: float = 0.0
-    frame_positions: bool = True
+    language: Part | None = None      # None: PGAE's LSTM over one-hot words (see the module)
+    crossmodal: Part | None = None    # None: the GMU
+    binding: Part | None = None       # None: one model for every signal
 
     def __post_init__(self):
         for name in ("units", "layers", "hidden"):
-            _whole(name, getattr(self, name), 1)
+            whole("ModelConfig", name, getattr(self, name), 1)
         if self.cell not in CELLS:
             raise ValueError(f"unknown cell {self.cell!r}; the options are: {', '.join(CELLS)}")
         if self.joint_feedback not in JOINT_FEEDBACKS:
             raise ValueError(f"unknown joint_feedback {self.joint_feedback!r}; the options are: "
                              f"{', '.join(JOINT_FEEDBACKS)}")
-        if not isinstance(self.gmu_norm, bool):
-            raise ValueError(f"gmu_norm must be True or False; got {self.gmu_norm!r}")
-        _whole("plan_keyframes", self.plan_keyframes, 0, " (0 = no plan head, the paper's)")
-        _whole("time_stride", self.time_stride, 1, " (1 = every step, the paper's)")
-        if self.bottleneck not in BOTTLENECKS:
-            raise ValueError(f"unknown bottleneck {self.bottleneck!r}; the options are: {', '.join(BOTTLENECKS)}")
-        _whole("heads", self.heads, 1)
-        _whole("feedforward", self.feedforward, 1)
-        if isinstance(self.dropout, bool) or not isinstance(self.dropout, (int, float)) or not 0 <= self.dropout < 1:
-            raise ValueError(f"ModelConfig dropout must be a number in [0, 1); got {self.dropout!r}")
-        if not isinstance(self.frame_positions, bool):
-            raise ValueError(f"frame_positions must be True or False; got {self.frame_positions!r}")
-        if self.bottleneck == "crossmodal-transformer":
-            if self.hidden % self.heads:
-                raise ValueError(f"the crossmodal transformer splits its width (hidden={self.hidden}) among "
-                                 f"{self.heads} heads: hidden must be a multiple of heads")
-            if self.language_encoder != "lstm":
-                raise ValueError(f"the crossmodal transformer reads the words as tokens itself; "
-                                 f"language_encoder={self.language_encoder!r} needs bottleneck='gmu'")
-        if self.language_encoder not in LANGUAGE_ENCODERS:
-            raise ValueError(f"unknown language_encoder {self.language_encoder!r}; "
-                             f"the options are: {', '.join(LANGUAGE_ENCODERS)}")
-        if not isinstance(self.tuned_top_layer, bool):
-            raise ValueError(f"tuned_top_layer must be True or False; got {self.tuned_top_layer!r}")
-        if self.tuned_top_layer and self.language_encoder == "lstm":
-            raise ValueError(f"tuned_top_layer needs a pretrained language encoder ('pretrained' or "
-                             f"'pretrained-attention'); got language_encoder={self.language_encoder!r}")
+        flag("ModelConfig", "gmu_norm", self.gmu_norm)
+        whole("ModelConfig", "plan_keyframes", self.plan_keyframes, 0, " (0 = no plan head, the paper's)")
+        whole("ModelConfig", "time_stride", self.time_stride, 1, " (1 = every step, the paper's)")
+        for name in PARTS:
+            part = getattr(self, name)
+            if part is not None and not isinstance(part, Part):
+                raise ValueError(f"ModelConfig {name} must be None or a part's settings (e.g. "
+                                 f"pgae_lite.bert.pretrained.PretrainedConfig()); got {part!r}")
+            if part is not None:
+                part.check(self)
+        if self.crossmodal is not None and self.binding is not None:
+            raise ValueError("a model has one bottleneck: PTAE's crossmodal transformer (crossmodal) or PRAE's "
+                             "and PVAE's binding loss (binding), not both")
 
     @property
     def state_dim(self) -> int:
         return 2 * self.layers * self.units  # [c_0; h_0; c_1; h_1]
 
+    def to_dict(self) -> dict:
+        """Every setting as plain values, each part as its dict (None where unset): what a recipe saves."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        return d | {name: None if d[name] is None else d[name].to_dict() for name in PARTS}
 
-__all__ = ["BOTTLENECKS", "CELLS", "JOINT_FEEDBACKS", "LANGUAGE_ENCODERS", "ModelConfig"]
+
+__all__ = ["CELLS", "JOINT_FEEDBACKS", "ModelConfig", "PARTS", "Part", "flag", "whole"]

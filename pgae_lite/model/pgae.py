@@ -21,17 +21,17 @@ the paper: :func:`pgae_lite.world.colours.with_colour`); the default is the pape
 """
 from __future__ import annotations
 
-from typing import Callable
-
 import torch
 from torch import nn
 
 from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
 from pgae_lite.model.config import ModelConfig
+from pgae_lite.model.language import LanguageEncoderBase
 from pgae_lite.model.layers import GatedMultimodalUnit, make_recurrent, state_to_vector, vector_to_state
+from pgae_lite.model.loss import LearnsFromSignals
 from pgae_lite.model.plan import PlanHead
 from pgae_lite.model.signals import SignalBatch
-from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, LanguageError, Lexicon
+from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, Lexicon, word_weights
 
 WORDS = len(VOCABULARY)
 
@@ -53,30 +53,16 @@ def embedding_init_(rnn: nn.Module) -> None:
     nn.init.normal_(rnn.input_weight, 0.0, 1.0)
 
 
-class LanguageEncoder(nn.Module):
+class LanguageEncoder(LanguageEncoderBase):
     """LSTM over one-hot tokens (signal first); f = final [c; h] of every layer.
 
     The tokens are those of :func:`pgae_lite.model.signals.make_batch`: the signal s first, as
     token 23 + s, then word indices. With a lexicon of V > 23 words the signal's one-hot
     dimension is V + s (the words' come first), so the first token moves by V - 23.
-
-    Every language encoder PGAE reads has this interface: ``output_dim``, ``forward(tokens,
-    lengths)``, ``reads_free_text``, ``read_as(text)`` (the text as the encoder reads it) and
-    ``encode_texts(texts)``. This one reads the dataset's words only; the pretrained encoders of
-    :mod:`pgae_lite.bert` read any text.
+    It reads the dataset's words only (:class:`~pgae_lite.model.language.LanguageEncoderBase`,
+    the interface every language encoder has); the pretrained encoders of :mod:`pgae_lite.bert`
+    read any text.
     """
-
-    reads_free_text = False
-
-    def read_as(self, text: str) -> str:
-        """The text as this encoder reads it: as it is (it must be a description)."""
-        return text
-
-    def encode_texts(self, texts: list[str]) -> torch.Tensor:
-        """Free text: not for this encoder, which reads one-hot tokens of the dataset's words."""
-        raise LanguageError("PGAE's LSTM language encoder reads only the dataset's words, as tokens "
-                            "(pgae_lite.model.signals.make_batch); free text needs a pretrained encoder "
-                            "(ModelConfig language_encoder='pretrained' or 'pretrained-attention')")
 
     def __init__(self, cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
@@ -244,27 +230,30 @@ class ActionDecoder(nn.Module):
         return torch.empty_like(joints).index_copy_(0, order, joints)   # back to the batch's order
 
 
-class PGAE(nn.Module):
+def build_language_encoder(cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON) -> LanguageEncoderBase:
+    """The language encoder ``cfg`` names: PGAE's LSTM, or what its ``language`` part builds (a pretrained
+    transformer: :mod:`pgae_lite.bert`, :mod:`pgae_lite.freeform`)."""
+    return LanguageEncoder(cfg, lexicon) if cfg.language is None else cfg.language.build(lexicon)
+
+
+class PGAE(LearnsFromSignals, nn.Module):
     """The whole model: two encoders, the GMU, two decoders.
 
-    ``lexicon``: the words it reads and writes (default: the paper's 23).
-    ``make_language_encoder(cfg, lexicon)``: builds the language encoder (default: the LSTM);
-    :func:`pgae_lite.bert.encoders.build_pgae` passes the pretrained ones.
+    ``lexicon``: the words it reads and writes (default: the paper's 23). The language encoder is
+    the LSTM, or the pretrained one ``cfg.language`` builds (PGAE-BERT). What it learns from and how
+    it is trained: :class:`~pgae_lite.model.loss.LearnsFromSignals`.
     """
 
-    def __init__(self, cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON,
-                 make_language_encoder: Callable[[ModelConfig, Lexicon], nn.Module] | None = None):
+    def __init__(self, cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
         self.cfg = cfg or ModelConfig()
+        if self.cfg.crossmodal is not None or self.cfg.binding is not None:
+            raise ValueError("PGAE joins its two encoders in a GMU; a ModelConfig with crossmodal (PTAE) or binding "
+                             "(PRAE, PVAE) builds another model: pgae_lite.model.build.build_model(cfg)")
         self.lexicon = lexicon
-        # the LSTM (PGAE), or what make_language_encoder builds: a pretrained transformer (PGAE-BERT),
-        # passed in by pgae_lite.bert.encoders.build_pgae; built here, in this order, for the same weights
-        if make_language_encoder is None:
-            if self.cfg.language_encoder != "lstm":
-                raise ValueError(f"language_encoder={self.cfg.language_encoder!r} is built by pgae_lite.bert: "
-                                 "build the model with pgae_lite.bert.encoders.build_pgae(cfg)")
-            make_language_encoder = LanguageEncoder
-        self.language_encoder = make_language_encoder(self.cfg, lexicon)
+        self.register_buffer("word_weights", word_weights(lexicon), persistent=False)   # the loss's, (words,)
+        # built here, in this order, for the same weights under a seed
+        self.language_encoder = build_language_encoder(self.cfg, lexicon)
         self.action_encoder = ActionEncoder(self.cfg)
         self.gmu = GatedMultimodalUnit(self.cfg.state_dim, self.language_encoder.output_dim, self.cfg.hidden,
                                        normalise_action=self.cfg.gmu_norm)

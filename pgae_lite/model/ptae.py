@@ -21,21 +21,56 @@ Deviation from paper: the decoders are the book's (``ModelConfig.units`` × ``la
 PTAE's: 2 × 128), with its time stride and plan head; the frames are those of the action
 encoder's time stride, and padding frames are masked from the attention (authors: none). The
 book's PTAE is 128 wide with a feed-forward of 512, no dropout, and positions on the frames
-(:class:`~pgae_lite.model.config.ModelConfig`, where each is measured).
+(:class:`CrossmodalConfig`, where each is measured).
 """
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import ClassVar
 
 import torch
 from torch import nn
 
 from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
-from pgae_lite.model.config import ModelConfig
+from pgae_lite.model.config import ModelConfig, Part, flag, whole
+from pgae_lite.model.language import LanguageEncoderBase
+from pgae_lite.model.loss import LearnsFromSignals
 from pgae_lite.model.pgae import ActionDecoder, LanguageDecoder, lstm_steps_of
 from pgae_lite.model.plan import PlanHead
 from pgae_lite.model.signals import SignalBatch
-from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, LanguageError, Lexicon
+from pgae_lite.world.words import DEFAULT_LEXICON, VOCABULARY, LanguageError, Lexicon, word_weights
+
+
+@dataclass(frozen=True)
+class CrossmodalConfig(Part):
+    """PTAE's crossmodal transformer (``ModelConfig.crossmodal``): one layer of ``heads`` heads and a feed-forward
+    of ``feedforward`` units, ``ModelConfig.hidden`` wide. The book's PTAE is 128 wide (runs/rows.py); PTAE's
+    authors: 4 heads, 256, 1024, dropout 0.25, no positions on the frames."""
+
+    kind: ClassVar[str] = "crossmodal-transformer"
+    heads: int = 4
+    # Deviation from paper: a feed-forward of 512 (PTAE: 1024), no dropout (PTAE: 0.25), and the frames read
+    # with their positions (PTAE: none; push and pull visit the same poses in opposite orders). Each change
+    # and what it did on the authors' data: benchmarks/ptae_recipe.py (results/ptae_recipe.json, A2).
+    feedforward: int = 512
+    dropout: float = 0.0
+    frame_positions: bool = True
+
+    def __post_init__(self):
+        whole("CrossmodalConfig", "heads", self.heads, 1)
+        whole("CrossmodalConfig", "feedforward", self.feedforward, 1)
+        if isinstance(self.dropout, bool) or not isinstance(self.dropout, (int, float)) or not 0 <= self.dropout < 1:
+            raise ValueError(f"CrossmodalConfig dropout must be a number in [0, 1); got {self.dropout!r}")
+        flag("CrossmodalConfig", "frame_positions", self.frame_positions)
+
+    def check(self, owner: ModelConfig) -> None:
+        if owner.hidden % self.heads:
+            raise ValueError(f"the crossmodal transformer splits its width (hidden={owner.hidden}) among "
+                             f"{self.heads} heads: hidden must be a multiple of heads")
+        if owner.language is not None:
+            raise ValueError(f"the crossmodal transformer reads the words as tokens itself; a language encoder "
+                             f"({owner.language!r}) needs the GMU (ModelConfig crossmodal=None)")
 
 
 def positional_encoding(length: int, width: int) -> torch.Tensor:
@@ -51,32 +86,21 @@ def positional_encoding(length: int, width: int) -> torch.Tensor:
     return pe
 
 
-class TokenEmbedding(nn.Module):
+class TokenEmbedding(LanguageEncoderBase):
     """PTAE's language input: the signal and the words, each one-hot, embedded and placed.
 
-    X_L = LN(ReLU(W_L x)) + PE, one row per token. It has the interface of PGAE's language
-    encoders (``reads_free_text``, ``read_as``, ``encode_texts``): it reads the dataset's words only.
+    X_L = LN(ReLU(W_L x)) + PE, one row per token. It is a language encoder
+    (:class:`~pgae_lite.model.language.LanguageEncoderBase`) that reads the dataset's words only.
     """
-
-    reads_free_text = False
 
     def __init__(self, cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
         self.input_dim = lexicon.input_dim                    # 28 for the paper's words
         self.signal_shift = lexicon.size - len(VOCABULARY)    # 0 for the paper's
         self.embed = nn.Linear(self.input_dim, cfg.hidden)
-        self.dropout = nn.Dropout(cfg.dropout)
+        self.dropout = nn.Dropout(cfg.crossmodal.dropout)
         self.norm = nn.LayerNorm(cfg.hidden)
         self.output_dim = cfg.hidden
-
-    def read_as(self, text: str) -> str:
-        """The text as PTAE reads it: as it is (it must be a description)."""
-        return text
-
-    def encode_texts(self, texts: list[str]) -> torch.Tensor:
-        """Free text: not for PTAE, which reads one-hot tokens of the dataset's words."""
-        raise LanguageError("PTAE reads only the dataset's words, as tokens (pgae_lite.model.signals.make_batch); "
-                            "free text needs PGAE-BERT")
 
     def forward(self, tokens: torch.Tensor) -> torch.Tensor:
         if self.signal_shift:                                                     # signal 23 + s -> V + s
@@ -92,9 +116,9 @@ class FrameEmbedding(nn.Module):
     def __init__(self, cfg: ModelConfig):
         super().__init__()
         self.stride = cfg.time_stride
-        self.positions = cfg.frame_positions
+        self.positions = cfg.crossmodal.frame_positions
         self.embed = nn.Linear(VISION_DIM + JOINT_DIM, cfg.hidden)
-        self.dropout = nn.Dropout(cfg.dropout)
+        self.dropout = nn.Dropout(cfg.crossmodal.dropout)
         self.norm = nn.LayerNorm(cfg.hidden)
 
     def forward(self, inputs: torch.Tensor, lengths: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
@@ -136,7 +160,7 @@ class CrossmodalTransformer(nn.Module):
         return self.norm_out(y + self.dropout(self.feedforward(y))), attention   # LN(Y + W_2 ReLU(W_1 Y))
 
 
-class PTAE(nn.Module):
+class PTAE(LearnsFromSignals, nn.Module):
     """The whole model: tokens and frames into the crossmodal transformer, h into PGAE's two decoders.
 
     It answers as :class:`~pgae_lite.model.pgae.PGAE` does (``encode``, ``forward``, the same
@@ -146,14 +170,15 @@ class PTAE(nn.Module):
 
     def __init__(self, cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
-        self.cfg = cfg or ModelConfig(bottleneck="crossmodal-transformer", hidden=128)
-        if self.cfg.bottleneck != "crossmodal-transformer":
-            raise ValueError(f"PTAE is the crossmodal-transformer bottleneck; got bottleneck={self.cfg.bottleneck!r}")
+        self.cfg = cfg or ModelConfig(hidden=128, crossmodal=CrossmodalConfig())
+        if self.cfg.crossmodal is None:
+            raise ValueError("PTAE is the crossmodal transformer: its ModelConfig needs crossmodal=CrossmodalConfig()")
         self.lexicon = lexicon
+        self.register_buffer("word_weights", word_weights(lexicon), persistent=False)   # the loss's, (words,)
         self.language_encoder = TokenEmbedding(self.cfg, lexicon)
         self.action_encoder = FrameEmbedding(self.cfg)
-        self.transformer = CrossmodalTransformer(self.cfg.hidden, self.cfg.heads, self.cfg.feedforward,
-                                                 self.cfg.dropout)
+        part = self.cfg.crossmodal
+        self.transformer = CrossmodalTransformer(self.cfg.hidden, part.heads, part.feedforward, part.dropout)
         self.language_decoder = LanguageDecoder(self.cfg, lexicon)
         self.action_decoder = ActionDecoder(self.cfg)
         self.plan_head = (PlanHead(self.cfg.hidden, self.cfg.plan_keyframes, self.cfg.units)
@@ -182,4 +207,5 @@ class PTAE(nn.Module):
         return out
 
 
-__all__ = ["CrossmodalTransformer", "FrameEmbedding", "PTAE", "TokenEmbedding", "positional_encoding"]
+__all__ = ["CrossmodalConfig", "CrossmodalTransformer", "FrameEmbedding", "PTAE", "TokenEmbedding",
+           "positional_encoding"]

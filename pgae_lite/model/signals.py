@@ -48,6 +48,7 @@ class SignalBatch:
     start_joints: torch.Tensor    # (B, 5) joints at step 0 of the output
     joint_target: torch.Tensor    # (B, T-1, 5) joints of steps 1..T-1
     joint_mask: torch.Tensor      # (B, T-1) bool, valid steps
+    plan_target: torch.Tensor | None = None   # (B, K x 5) in training, with a plan head (model/loss.py)
 
 
 def signal_ids(names: list[str] | str, batch: int | None = None) -> torch.Tensor:

@@ -32,7 +32,7 @@ replay then passes 216 of 216. ``tracking=False`` sends ĵ_t as it is (what
 :func:`~pgae_lite.sim.record.execute_trajectory` does).
 
 :func:`open_loop` executes a joint trajectory computed in advance (e.g. the
-paper's execute, from :func:`pgae_lite.evaluate.predict`) the same way;
+paper's execute, from :func:`pgae_lite.evaluate.table1.predict`) the same way;
 :func:`compare` runs both over a set of episodes.
 
 Free-form instructions, executed both ways, are in :mod:`pgae_lite.robot.instructions`.
@@ -50,11 +50,11 @@ from tqdm.auto import tqdm
 from pgae_lite.cae import ChannelSeparatedCAE, extract_features
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
-from pgae_lite.data.simulated import DatasetConfig
-from pgae_lite.evaluate import predict
+from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
-from pgae_lite.robot.refusals import check_instruction
+from pgae_lite.freeform.refusals import check_instruction
 from pgae_lite.sim.record import Execution, Simulation
 from pgae_lite.sim.robot import HOME_POSE
 from pgae_lite.viz import animate_frames
@@ -129,7 +129,7 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
     a pretrained encoder (``model.language_encoder.encode_texts([text])``),
     passed on as ``model.encode(batch, language=language)``; ``description`` is
     then only the rollout's label, and the instruction checked: text the robot will not act on
-    (:mod:`pgae_lite.robot.refusals`) raises :class:`~pgae_lite.robot.refusals.CannotDo`.
+    (:mod:`pgae_lite.freeform.refusals`) raises :class:`~pgae_lite.freeform.refusals.CannotDo`.
     """
     config = config or PROFILES["book"].data
     model.eval()

@@ -2,12 +2,12 @@
 
 Paper, Sec. 3 and 5: PGAE-BERT "has the potential to recognise unseen natural
 language". :func:`execute_paraphrases` gives every test episode one of the
-held-out paraphrases of its own instruction (:mod:`pgae_lite.bert.paraphrases`,
+held-out paraphrases of its own instruction (:mod:`pgae_lite.freeform.paraphrases`,
 e.g. "Could you shove the crimson cube forward in a hurry" for "push red
 fast") and executes it both ways, through :func:`instruction_features`
 (PGAE-BERT's transformer reads any text; PGAE's LSTM only its vocabulary, and
 says which words it does not know) and the paper's execute with those features
-(:func:`pgae_lite.evaluate.predict` with ``language=``, the open loop) as well
+(:func:`pgae_lite.evaluate.table1.predict` with ``language=``, the open loop) as well
 as :func:`pgae_lite.robot.closedloop.closed_loop`.
 """
 from __future__ import annotations
@@ -17,16 +17,16 @@ import pandas as pd
 import torch
 from tqdm.auto import tqdm
 
-from pgae_lite.bert.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.bert.pretrained import check_texts, input_text
 from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.data.simulated import DatasetConfig
-from pgae_lite.evaluate import predict
+from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.evaluate.table1 import predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
 from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
-from pgae_lite.robot.refusals import refusal
+from pgae_lite.freeform.refusals import refusal
 from pgae_lite.util.checks import whole_number
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize
@@ -113,17 +113,17 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     """Free-form instructions executed in their episodes' scenes, open and closed loop; one row per episode.
 
     Every episode of ``split`` whose meaning has a paraphrase (default: the 108 of
-    :func:`~pgae_lite.bert.paraphrases.load_paraphrases`) is told one
+    :func:`~pgae_lite.freeform.paraphrases.load_paraphrases`) is told one
     (:func:`paraphrase_of`), encoded by :func:`instruction_features`: PGAE-BERT
     reads it, PGAE's LSTM raises a LanguageError naming the unknown words before
     anything runs. Then, as in :func:`~pgae_lite.robot.closedloop.compare`: the paper's
-    execute (:func:`~pgae_lite.evaluate.predict` with ``language=``) run in the
+    execute (:func:`~pgae_lite.evaluate.table1.predict` with ``language=``) run in the
     simulator (``open_*`` columns) and, if ``closed``,
     :func:`~pgae_lite.robot.closedloop.closed_loop` (``closed_*``). nRMSE (%) is against
     the recorded joints of the episode, the intended action. ``limit``: that many
     episodes, evenly spread. ``route``: ``"direct"`` (the paper's: the instruction's
     features) or ``"said back"`` (:func:`say_back`, then those words; the ``acted_on``
-    column). Instructions the robot will not act on (:mod:`pgae_lite.robot.refusals`: a negation,
+    column). Instructions the robot will not act on (:mod:`pgae_lite.freeform.refusals`: a negation,
     more than one instruction, a cube not in the episode's scene, ...) are not executed: their
     ``refused`` column says why (it is empty for the others).
     """
@@ -143,7 +143,7 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     said, refused = [None] * len(texts), [None] * len(texts)      # PGAE's LSTM: descriptions, none refused
     if model.language_encoder.reads_free_text:
         said = say_back(model, episodes, normaliser, texts)
-        refused = [refusal(text, model.language_encoder, scene_of(int(p)), back)   # robot/refusals.py
+        refused = [refusal(text, model.language_encoder, scene_of(int(p)), back)   # freeform/refusals.py
                    for text, p, back in zip(texts, episodes.pattern, said)]
     if route == "said back":
         texts = acted_on(said, texts)

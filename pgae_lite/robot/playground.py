@@ -16,7 +16,7 @@ episode's and picks the episode itself, the action it names in the chosen
 arrangement. PGAE's LSTM reads only those 22 words; PGAE-BERT's transformer
 reads any text (paper, Sec. 3), then the chosen action is the one meant. Free text the robot
 will not act on under ``execute`` (a negation, more than one instruction, a cube not on the
-table: :mod:`pgae_lite.robot.refusals`) is refused with the reason; where the model's readback
+table: :mod:`pgae_lite.freeform.refusals`) is refused with the reason; where the model's readback
 and the chosen action disagree, the result's ``note`` says so.
 Under ``describe`` and ``repeat action`` the model reads no words, and a typed
 description only picks the episode. Bad text raises a
@@ -37,7 +37,7 @@ from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
-from pgae_lite.data.simulated import DatasetConfig
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
@@ -45,7 +45,7 @@ from pgae_lite.robot.instructions import acted_on, check_route
 from pgae_lite.robot.play_result import TARGETS, PlayResult
 from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number, check_objects,
                                                 check_playground)
-from pgae_lite.robot.refusals import check_instruction, disagreement
+from pgae_lite.freeform.refusals import check_instruction, disagreement
 from pgae_lite.robot.typed_text import read_typed
 from pgae_lite.util.checks import instance_of, whole_number
 from pgae_lite.util.errors import PGAELiteError

@@ -1,39 +1,51 @@
-"""From nothing to a dataset PGAE learns from: simulator -> CAE -> visual features.
+"""From nothing to trained models: simulator -> CAE -> visual features -> any model of the book.
 
 Paper, Sec. 4 (dataset) and Sec. 3 (visual features from a channel-separated
 CAE), on our simulated data. Each heavy step is cached, keyed by its config,
 so every chapter can call :func:`simulated_dataset` and get in seconds what an
 earlier chapter (or ``python -m pgae_lite simulate``) already made:
 
-1. :func:`pgae_lite.data.simulated.generate` records the episodes;
+1. :func:`pgae_lite.sim.dataset.generate` records the episodes of the profile's
+   world (the paper's, or one with a new colour: ``DatasetConfig.world``);
 2. :func:`trained_cae` trains the CAE on frames of the training episodes only;
 3. :func:`simulated_dataset` encodes every frame of both views into 30
    features and returns a :class:`~pgae_lite.data.dataset.PGAEDataset`;
-4. :func:`trained_pgae` trains one of Table 1's models on it (PGAE, PGAE-BERT,
-   or the model of PGAE-self / PGAE-opposite), cached the same way;
-   :func:`trained_pgaes` trains several side by side, one per CPU core.
+4. :func:`trained_model` trains one training of :mod:`pgae_lite.runs.rows` on it
+   (a row's model of Table 1 or of the family, or a side training), cached the
+   same way, by the one training loop; :func:`trained_models` trains several
+   side by side, one per CPU core. :func:`load_model` reads a saved model back.
+
+Every function takes a :class:`~pgae_lite.config.Profile`, resolved once where the run starts.
 """
 from __future__ import annotations
 
 import os
 import time
 import warnings
+from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
-from pgae_lite.bert.phrase_lexicon import training_lexicon
-from pgae_lite.bert.phrasings import phrasings_digest
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
-from pgae_lite.config import Profile, Training, as_training, get_profile, training_profile
-from pgae_lite.data.dataset import DataFormatError, PGAEDataset
-from pgae_lite.data.simulated import DatasetConfig, episode_name, generate, to_dataset, training_frames
+from pgae_lite.config import Profile, recipe_from_dict
+from pgae_lite.data.dataset import DataFormatError, Normaliser, PGAEDataset
+from pgae_lite.freeform.phrase_lexicon import training_lexicon
+from pgae_lite.freeform.phrasing_bank import for_training
+from pgae_lite.freeform.phrasings import phrasings_digest
+from pgae_lite.model.build import build_model
+from pgae_lite.runs.rows import Training
 from pgae_lite.runs.sweep import run_sweep
+from pgae_lite.sim.dataset import DatasetConfig, episode_name, generate, to_dataset, training_frames
+from pgae_lite.util.checks import instance_of
 from pgae_lite.util.storage import (CorruptCheckpointError, FolderBusyError, cache_dir, config_digest,
-                                    default_device, make_folder)
+                                    default_device, load_torch, make_folder)
 
 if TYPE_CHECKING:
+    import torch
+
     from pgae_lite.train.loop import Trained
 
 BUSY_POLL_SECONDS = 5      # how often trained_pgae looks whether another process's training has ended
@@ -49,15 +61,16 @@ def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
     return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
 
 
-def trained_cae(profile: Profile | str | None = None, device: str | None = None, progress: bool = True,
-                workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
-    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history.
+def profile_of(profile: Profile) -> Profile:
+    """``profile`` if it is a Profile; else a one-sentence error (a name is resolved once, where a run starts)."""
+    return instance_of("profile", profile, Profile, "a Profile, resolved once where the run starts: "
+                       "pgae_lite.config.get_profile(name)")
 
-    ``profile``: a :class:`~pgae_lite.config.Profile`, or a name resolved once here
-    (``None``: the default profile, :func:`pgae_lite.config.profile_name`).
-    """
-    prof = get_profile(profile)
-    data, cae = prof.data, prof.cae
+
+def trained_cae(profile: Profile, device: str | None = None, progress: bool = True,
+                workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
+    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
+    data, cae = profile_of(profile).data, profile.cae
     generate(data, workers=workers, progress=progress)
     return cached_cae(cae_path(data, cae), cae,
                       lambda: training_frames(data, cae.frame_stride), device, progress)
@@ -79,10 +92,10 @@ def cached_cae(path: Path, cae: CAEConfig, frames: Callable[[], np.ndarray],
     return train_cae(frames(), cae, device, progress, out_path=path)
 
 
-def simulated_dataset(profile: Profile | str | None = None, device: str | None = None, progress: bool = True,
+def simulated_dataset(profile: Profile, device: str | None = None, progress: bool = True,
                       workers: int | None = None) -> PGAEDataset:
     """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
-    prof = get_profile(profile)                  # a name is resolved once, here
+    prof = profile_of(profile)
     data, cae_config = prof.data, prof.cae
     path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
 
@@ -135,33 +148,40 @@ def model_folder(prof: Profile, training: str) -> Path:
     """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
     (the recipe's holds its version) and, for a training on phrasings, the sentences' own."""
     name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
-    if prof.train.phrasings:
-        name += "-" + phrasings_digest(prof.train.phrasings, prof.train.seed,
-                                       training_lexicon(prof.train.phrasing_words))
+    phrasings = prof.train.phrasings
+    if phrasings is not None:
+        name += "-" + phrasings_digest(phrasings.per_meaning, prof.train.seed, training_lexicon(phrasings.words))
     return cache_dir() / "pgae" / name
 
 
-def trained_pgae(training: Training | str = "PGAE", profile: Profile | str | None = None, seed: int = 0,
-                 device: str | None = None, progress: bool = True, **train_overrides) -> "Trained":
-    """A model of one training (for a row of Table 1) on the profile's simulated data, cached.
+def language_source(prof: Profile):
+    """What the training loop reads each batch's language features from, for ``prof``'s recipe: None, or for
+    a training on phrasings the free-form variant's bank (:func:`pgae_lite.freeform.phrasing_bank.for_training`)."""
+    phrasings = prof.train.phrasings
+    return None if phrasings is None else partial(for_training, config=phrasings, seed=prof.train.seed)
 
-    Loaded from the cache if it was trained before.
 
-    ``training`` is one of :data:`pgae_lite.config.TRAININGS` by name (``"PGAE"``,
-    ``"PGAE-BERT"``, ``"PGAE-views"`` for PGAE-self and PGAE-opposite), or any
-    :class:`~pgae_lite.config.Training` value (:mod:`pgae_lite.runs.trainings`);
-    ``train_overrides`` change the profile's training options (e.g. ``seed=1``); without
-    them it is the profile's recipe, the model every chapter and ``reproduce`` train.
-    An interrupted training resumes from its last checkpoint. When another process
-    is training the same model into the cache (two chapters run side by side), this
-    waits for it and then loads its model.
+def unit_profile(profile: Profile, training: Training, seed: int, dataset: PGAEDataset,
+                 pretrained_model: str | None = None) -> Profile:
+    """The recipe of one training with ``seed`` on ``dataset`` (its size: for a training whose authors counted
+    iterations, under the paper profile)."""
+    base = replace(profile_of(profile), train=replace(profile.train, seed=seed))
+    return training.profile(base, len(dataset.split("train")), pretrained_model)
+
+
+def trained_model(training: Training, profile: Profile, seed: int = 0, device: str | None = None,
+                  progress: bool = True) -> "Trained":
+    """The model of one training (:mod:`pgae_lite.runs.rows`: a row's of Table 1 or of the family, or a side
+    training) on the profile's simulated data, cached: loaded if it was trained before.
+
+    An interrupted training resumes from its last checkpoint. When another process is training the same
+    model into the cache (two chapters run side by side), this waits for it and then loads its model.
     """
     from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError
 
-    training = as_training(training)
-    base = get_profile(profile, seed=seed, **train_overrides)       # a name is resolved once, here
-    dataset = _with_both_splits(simulated_dataset(base, device, progress))
-    prof = training_profile(base, training)
+    instance_of("training", training, Training, "a Training of pgae_lite.runs.rows (e.g. TRAININGS['PGAE'])")
+    dataset = _with_both_splits(simulated_dataset(profile, device, progress))
+    prof = unit_profile(profile, training, seed, dataset)
     folder = model_folder(prof, training.name)
     while True:
         try:
@@ -182,7 +202,8 @@ def train_when_free(dataset: PGAEDataset, prof: Profile, folder: Path, device: s
     announced = False
     while True:
         try:
-            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=name)
+            return train(dataset, prof, out_dir=folder, device=device, progress=progress, name=name,
+                         language=language_source(prof))
         except FolderBusyError:
             if announce and not announced:
                 print(f"{name}: another process is training this model; waiting for it ...", flush=True)
@@ -198,36 +219,34 @@ def _with_both_splits(dataset: PGAEDataset) -> PGAEDataset:
 
 
 def _train_alone(training: Training, profile: Profile, seed: int) -> float:
-    """A worker of :func:`trained_pgaes`: one training on one thread; its training time (s)."""
+    """A worker of :func:`trained_models`: one training on one thread; its training time (s)."""
     import torch
 
     torch.set_num_threads(1)
-    return trained_pgae(training, profile, seed, device="cpu", progress=False).seconds
+    return trained_model(training, profile, seed, device="cpu", progress=False).seconds
 
 
-def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None = None, seed: int = 0,
-                  device: str | None = None,
-                  progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
-    """Several of :func:`trained_pgae`'s models, by training name; those not cached are trained side by side.
+def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, device: str | None = None,
+                   progress: bool = True, workers: int | None = None) -> dict[str, "Trained"]:
+    """Several of :func:`trained_model`'s models, by training name; those not cached are trained side by side.
 
     On a CPU the missing models train at the same time, each a unit of a sweep
     (:func:`pgae_lite.runs.sweep.run_sweep`) on a worker process of one thread, ``workers``
     at once (default: one per core). These networks are small: on the book's 2-core
     machine one training on both cores ran no faster than on one (A2, "Where the time
     goes"), so two trainings side by side take about the time of one. With a GPU, or one
-    model to train, they train one after another in this process, as :func:`trained_pgae`
+    model to train, they train one after another in this process, as :func:`trained_model`
     does. Workers are spawned, so a script that calls this needs the usual
     ``if __name__ == "__main__":`` guard.
     """
     import torch
 
-    trainings = [as_training(t) for t in trainings]
-    prof = get_profile(profile)                                     # a name is resolved once, here
+    prof = profile_of(profile)
     cpu = torch.device(device or default_device()).type == "cpu"
-    todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed)]
+    dataset = _with_both_splits(simulated_dataset(prof, device, progress))   # made once, before the workers read it
+    todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed, dataset)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
-        _with_both_splits(simulated_dataset(prof, device, progress))   # made once, before the workers read it
         if progress:
             names = ", ".join(t.name for t in todo)
             print(f"training {names} side by side, {workers} at a time, one core each ...", flush=True)
@@ -236,21 +255,43 @@ def trained_pgaes(trainings: list[Training | str], profile: Profile | str | None
         for training, s in zip(todo, seconds):
             if progress:
                 print(f"{training.name}: trained in {s / 60:.1f} min", flush=True)
-    return {t.name: trained_pgae(t, prof, seed, device, progress) for t in trainings}
+    return {t.name: trained_model(t, prof, seed, device, progress) for t in trainings}
 
 
-def is_trained(training: Training, profile: Profile, seed: int) -> bool:
-    """Whether :func:`trained_pgae` would load this model from the cache, trained to its last epoch."""
+def is_trained(training: Training, profile: Profile, seed: int, dataset: PGAEDataset) -> bool:
+    """Whether :func:`trained_model` would load this model from the cache, trained to its last epoch."""
     from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 
-    prof = training_profile(get_profile(profile, seed=seed), training)
-    folder = model_folder(prof, training.name)
+    prof = unit_profile(profile, training, seed, dataset)
     try:
-        return load_checkpoint(folder / CHECKPOINT)["epoch"] >= prof.train.epochs
-    except Exception:  # noqa: BLE001 -- missing or damaged: trained_pgae trains (again)
+        return load_checkpoint(model_folder(prof, training.name) / CHECKPOINT)["epoch"] >= prof.train.epochs
+    except Exception:  # noqa: BLE001 -- missing or damaged: trained_model trains (again)
         return False
 
 
-__all__ = ["simulated_dataset", "trained_cae", "trained_pgae", "trained_pgaes", "train_when_free", "cae_path",
-           "model_folder", "is_trained",
-           "cached_cae", "cached_dataset", "made_otherwise"]
+def load_model(path: str | Path, device: "torch.device | str | None" = None, dataset: PGAEDataset | None = None,
+               lexicon=None) -> tuple["torch.nn.Module", Normaliser, dict]:
+    """Model (in eval mode), normaliser and the checkpoint's other contents, from a checkpoint any training of
+    the book wrote (``lexicon``: a model of a larger vocabulary, e.g. a world with a new colour).
+
+    With ``dataset``, first check that the model was trained on it: the normaliser fitted on its training
+    samples must equal the one saved. The visual features come from a CAE, and two CAEs (e.g. trained with
+    another number of threads, in another cache) give different features: a model fed another CAE's
+    features produces nonsense without any error, so this raises a DataMismatchError instead.
+    """
+    from pgae_lite.train.checkpoint import check_fitted_on, check_recipe_version, load_weights
+    from pgae_lite.world.words import DEFAULT_LEXICON
+
+    ckpt = load_torch(path, ("model", "profile", "normaliser"))
+    if dataset is not None:
+        check_fitted_on(ckpt, dataset, path)
+    model_cfg, recipe = recipe_from_dict(check_recipe_version(ckpt["profile"], path))
+    model = load_weights(build_model(model_cfg, lexicon or DEFAULT_LEXICON), ckpt, path)
+    model.at_step(recipe.epochs, recipe.epochs)                       # its training is over
+    model.to(device or default_device()).eval()
+    return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
+
+
+__all__ = ["cae_path", "cached_cae", "cached_dataset", "is_trained", "language_source", "load_model",
+           "made_otherwise", "model_folder", "profile_of", "simulated_dataset", "train_when_free", "trained_cae",
+           "trained_model", "trained_models", "unit_profile"]

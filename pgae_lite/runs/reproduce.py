@@ -1,17 +1,11 @@
 """Reproducing Table 1: train the rows' models, evaluate them, print them beside the paper's.
 
-Paper, Sec. 4 and Table 1. Four rows come from three trainings::
-
-    | row           | training                                   | evaluated on                  |
-    |---------------|--------------------------------------------|-------------------------------|
-    | PGAE          | LSTM language encoder, NICO's view only     | NICO's own actions            |
-    | PGAE-BERT     | frozen pretrained language encoder          | NICO's own actions            |
-    | PGAE-self     | NICO's or the opposite agent's view, 50/50  | NICO's own actions            |
-    | PGAE-opposite | the same model as PGAE-self                 | the opposite agent's actions  |
-
-``execute`` and ``repeat language`` show no action to the encoder beyond the
-first step, so PGAE-opposite shares those two cells with PGAE-self (as in the
-paper). With several seeds every cell is reported as mean ± standard deviation.
+Paper, Sec. 4 and Table 1. Table 1's four rows come from three trainings, and the family's rows
+(PRAE, PVAE, PVAE-BERT(-tuned), PTAE) stand beside them (:mod:`pgae_lite.runs.rows`: how each is
+built, trained and measured). ``execute`` and ``repeat language`` show no action to the encoder
+beyond the first step, so PGAE-opposite shares those two cells with PGAE-self (as in the paper).
+A cell a model has no path for (PRAE's and PVAE's configurations) is N.A., ``null``. With several
+seeds every cell is reported as mean ± standard deviation.
 
 Output folder layout (``out``)::
 
@@ -37,11 +31,12 @@ from pathlib import Path
 import numpy as np
 
 from pgae_lite.bert.pretrained import model_source
-from pgae_lite.config import EVERY_ROW, ROWS, Profile, get_profile
+from pgae_lite.config import Profile, get_profile
 from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.evaluate import PAPER_TABLE, Predictions, format_table
+from pgae_lite.evaluate.table1 import Predictions, format_table
+from pgae_lite.runs.rows import ROWS, TABLE1_ROWS
 from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
-from pgae_lite.runs.table1_unit import check_made_on, remember_dataset, table1_unit, unit_profile
+from pgae_lite.runs.table1_unit import check_made_on, remember_dataset, table1_unit
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.util.storage import atomic_write, atomic_write_text, default_device, make_folder
@@ -62,17 +57,17 @@ def parse_rows(rows: str | list[str] | tuple[str, ...] | None) -> list[str]:
         return ["PGAE"]
     instance_of("rows", rows, (str, list, tuple), "'all', a list or names and commas")
     if isinstance(rows, str):
-        rows = list(ROWS) if rows.strip().lower() == "all" else rows.split(",")
+        rows = list(TABLE1_ROWS) if rows.strip().lower() == "all" else rows.split(",")
     if not rows:
-        raise ArgumentError(f"rows is empty; the rows are: {', '.join(EVERY_ROW)} or 'all'")
-    by_lower = {r.lower(): r for r in EVERY_ROW}
+        raise ArgumentError(f"rows is empty; the rows are: {', '.join(ROWS)} or 'all'")
+    by_lower = {r.lower(): r for r in ROWS}
     out = []
     for r in rows:
         name = by_lower.get(r.strip().lower()) if isinstance(r, str) else None
         if name is None:
             shown = r.strip() if isinstance(r, str) else r
             raise ArgumentError(f"unknown row {shown!r}; the rows are: "
-                                f"{', '.join(EVERY_ROW)} (or 'all': Table 1's)")
+                                f"{', '.join(ROWS)} (or 'all': Table 1's)")
         if name not in out:
             out.append(name)
     return out
@@ -112,12 +107,13 @@ def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained
             raise ArgumentError(f"{name[key]} is empty (an unset variable?); give a "
                                 f"folder, or leave {name[key]} out for the default: "
                                 f"{defaults[key]}")
-    if "PGAE-BERT" in rows:
+    pretrained = [r for r in rows if "language" in ROWS[r].training.model]    # a pretrained language encoder
+    if pretrained:
         model_source(pretrained_model)     # a missing model: refused before any data
     elif pretrained_model is not None:
-        raise ArgumentError(f"{name['pretrained_model']} {pretrained_model!r} is "
-                            f"PGAE-BERT's language model, but the rows "
-                            f"({', '.join(rows)}) do not include PGAE-BERT; add it to "
+        raise ArgumentError(f"{name['pretrained_model']} {pretrained_model!r} is the "
+                            f"pretrained language model of PGAE-BERT and PVAE-BERT, but no row "
+                            f"({', '.join(rows)}) reads it; add one to "
                             f"{name['rows']} or leave {name['pretrained_model']} out")
     return rows
 
@@ -182,9 +178,9 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
     dataset.split("train"), dataset.split("test")    # both needed: refused now, not after the trainings
     make_folder(out)                 # a file in the way, or no permission: one sentence
     source = None if original_data is None else str(Path(original_data).resolve())
-    trainings = list(dict.fromkeys(EVERY_ROW[r][0] for r in rows))
-    units = [(source, profile, t, seed, [r for r in rows if EVERY_ROW[r][0] == t], str(Path(out).resolve()), device,
-              pretrained_model) for t in trainings for seed in seeds]
+    trainings = list({ROWS[r].training.name: ROWS[r].training for r in rows}.values())
+    units = [(source, profile, t, seed, [ROWS[r] for r in rows if ROWS[r].training == t], str(Path(out).resolve()),
+              device, pretrained_model) for t in trainings for seed in seeds]
     if _as_sweep(len(units), device, workers, scheduler):
         done = run_sweep(table1_unit, units, workers=min(workers or os.cpu_count() or 1, len(units)),
                          scheduler=scheduler, logs=Path(out) / "logs", name="table1", progress=progress)
@@ -193,15 +189,13 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
         done = [table1_unit(*unit, progress=progress) for unit in units]
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:
-        report["rows"][row] = {"training": EVERY_ROW[row][0], "paper": {   # None: not a row of the paper's Table 1
-            s: {"accuracy": a, "nrmse": e} for s, (a, e) in PAPER_TABLE[row].items()} if row in ROWS else None,
-            "seeds": {}}
+        paper = ROWS[row].paper                                # None: not a row of the paper's Table 1
+        report["rows"][row] = {"training": ROWS[row].training.name, "paper": None if paper is None else {
+            s: {"accuracy": a, "nrmse": e} for s, (a, e) in paper.items()}, "seeds": {}}
     for unit in done:
-        prof = unit_profile(profile, unit["training"], unit["seed"], pretrained_model)
         folder = out / f"{unit['training']}-seed{unit['seed']}"
-        check_made_on(unit, dataset, prof, folder)    # trained elsewhere on other features: an error
-        info = report["trainings"].setdefault(unit["training"], {"profile": unit.get("profile", prof.to_dict()),
-                                                                 "train_seconds": {}})
+        check_made_on(unit, dataset, folder)          # trained elsewhere on other features: an error
+        info = report["trainings"].setdefault(unit["training"], {"profile": unit["profile"], "train_seconds": {}})
         info["train_seconds"][str(unit["seed"])] = unit["seconds"]
         for row, cells in unit["cells"].items():
             make_folder(folder)
@@ -210,7 +204,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
     for row in rows:
         mean, std = summarise([report["rows"][row]["seeds"][str(s)] for s in seeds])
         report["rows"][row] |= {"mean": mean, "std": std}
-    first = next(u for u in done if u["training"] == EVERY_ROW[rows[0]][0] and u["seed"] == seeds[0])
+    first = next(u for u in done if u["training"] == ROWS[rows[0]].training.name and u["seed"] == seeds[0])
     save_predictions(out / "predictions.npz", first["predictions"][rows[0]])
     return report
 
@@ -235,7 +229,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
 
     ``original_data`` is the authors' data folder; ``None`` runs the whole pipeline on
     our simulated data (simulator -> CAE -> PGAE, each step cached). ``rows``: see
-    :data:`pgae_lite.config.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
+    :data:`pgae_lite.runs.rows.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
     per row are trained, with seeds ``seed, seed + 1, ...``: on the CPU, side by side on ``workers``
     cores (default: all), or on the Dask cluster at ``scheduler`` (:func:`run_table1`). Every
     argument is checked before any data is read (:func:`check_arguments`).
@@ -249,7 +243,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
         dataset, source = load_original(original_data), "original"
     else:
         from pgae_lite.runs.pipeline import simulated_dataset
-        dataset, source = simulated_dataset(prof.name, device, progress), "simulated"
+        dataset, source = simulated_dataset(prof, device, progress), "simulated"
     default_out = f"runs/{source}-{prof.name}-seed{seed}"
     out = Path(out_dir if out_dir is not None else default_out)
     t0 = time.perf_counter()
@@ -259,7 +253,7 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
                "wall_seconds": time.perf_counter() - t0}
     nonfinite = write_results(out / "results.json", report)
     print(format_table({f"{r} (ours)": report["rows"][r]["mean"] for r in rows},
-                       {f"{r} (ours)": r for r in rows if r in ROWS},
+                       {f"{r} (ours)": r for r in rows if ROWS[r].paper is not None},
                        std={f"{r} (ours)": report["rows"][r]["std"] for r in rows} if seeds > 1 else None))
     times = ", ".join(f"{t} {statistics.fmean(v['train_seconds'].values()):.0f} s"
                       for t, v in report["trainings"].items())

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from pgae_lite.config import ROWS
+from pgae_lite.runs.rows import TABLE1_ROWS
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.util.storage import atomic_write_text
 from pgae_lite.world.words import TEST_SIGNALS
@@ -184,15 +184,16 @@ def measured(name: str) -> str:
 
 
 def table1_rows(name: str) -> dict[str, dict]:
-    """The rows of a ``benchmarks/table1.py`` result, each a row of Table 1 (:data:`~pgae_lite.config.ROWS`)."""
+    """The rows of a ``benchmarks/table1.py`` result, each a row of Table 1
+    (:data:`~pgae_lite.runs.rows.TABLE1_ROWS`)."""
     data = load(name)["data"].get("rows")
     if not isinstance(data, dict) or not data:
         raise ResultFileError(f"{name}.json: data.rows must be an object with one entry per row of Table 1 "
-                              f"({', '.join(ROWS)}); got {data!r:.60}")
+                              f"({', '.join(TABLE1_ROWS)}); got {data!r:.60}")
     for row, r in data.items():
-        if row not in ROWS:
+        if row not in TABLE1_ROWS:
             raise ResultFileError(f"{name}.json: row {row!r:.60} is not a row of Table 1; the rows "
-                                  f"are: {', '.join(ROWS)}")
+                                  f"are: {', '.join(TABLE1_ROWS)}")
         if not isinstance(r, dict):
             raise ResultFileError(f"{name}.json: rows[{row!r}] must be an object; got {r!r:.60}")
     return data

@@ -1,5 +1,9 @@
 """One unit of a Table 1 sweep: one training for one seed, trained (or resumed), then measured on its rows.
 
+Any row of :mod:`pgae_lite.runs.rows`, Table 1's or the family's: the model is trained by the one loop
+into ``OUT/TRAINING-seedS`` (:func:`~pgae_lite.runs.pipeline.train_when_free`: a later run with the same
+recipe and data loads it) and measured by the one evaluation, N.A. where it has no path.
+
 Paper, Sec. 4 and Table 1. ``reproduce`` over seeds is a list of these units, run one after
 another in this process or as tasks on a Dask cluster (:mod:`pgae_lite.runs.sweep`). A unit
 runs wherever its worker is, so it finds its data there (:func:`worker_dataset`): the
@@ -13,15 +17,14 @@ statistics its model was trained on, which the sweep's caller checks against its
 from __future__ import annotations
 
 import platform
-from dataclasses import replace
 from pathlib import Path
 
-from pgae_lite.config import CONFIGURED_ROWS, EVERY_ROW, Profile, training_profile
+from pgae_lite.config import Profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.evaluate import evaluate
+from pgae_lite.evaluate.table1 import evaluate
+from pgae_lite.runs.pipeline import simulated_dataset, train_when_free, unit_profile
+from pgae_lite.runs.rows import Row, Training
 from pgae_lite.train.checkpoint import check_trained_on, training_split
-from pgae_lite.runs.configured_unit import configured_profile, configured_unit
-from pgae_lite.runs.pipeline import simulated_dataset, train_when_free
 from pgae_lite.util.storage import cache_dir, config_digest
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
@@ -51,51 +54,41 @@ def remember_dataset(original_data: str | None, profile: Profile, dataset: PGAED
     _LOADED[_data_key(original_data, profile)] = dataset
 
 
-def unit_profile(profile: Profile, training: str, seed: int, pretrained_model: str | None = None) -> Profile:
-    """The recipe of one unit: ``profile`` with the training's changes and the seed (a configured row's:
-    :func:`~pgae_lite.runs.configured_unit.configured_profile`)."""
-    if training in CONFIGURED_ROWS:
-        return configured_profile(profile, training, seed)
-    return training_profile(replace(profile, train=replace(profile.train, seed=seed)), training, pretrained_model)
-
-
-def table1_unit(original_data: str | None, profile: Profile, training: str, seed: int, rows: list[str],
+def table1_unit(original_data: str | None, profile: Profile, training: Training, seed: int, rows: list[Row],
                 out: str, device: str | None = None, pretrained_model: str | None = None,
                 progress: bool = False) -> dict:
     """Train (or resume) ``training`` with ``seed`` into ``out/TRAINING-seedS``, measure its ``rows``.
 
     Returns ``{"training", "seed", "seconds", "cells": {row: cells}, "predictions": {row: {signal:
-    Predictions}}, "normaliser": the statistics it was trained on, "made_on": host and cache}``.
+    Predictions}}, "profile": the recipe, "normaliser": the statistics it was trained on, "made_on": host
+    and cache}``.
     """
     dataset = worker_dataset(original_data, profile, device)
-    if training in CONFIGURED_ROWS:         # PRAE, PVAE, PVAE-BERT(-tuned): per configuration, N.A. cells
-        return configured_unit(dataset, profile, training, seed, out, device)
-    prof = unit_profile(profile, training, seed, pretrained_model)
-    trained = train_when_free(dataset, prof, Path(out) / f"{training}-seed{seed}", device, progress, training)
+    prof = unit_profile(profile, training, seed, dataset, pretrained_model)
+    trained = train_when_free(dataset, prof, Path(out) / f"{training.name}-seed{seed}", device, progress,
+                              training.name)
     cells, predictions, self_results = {}, {}, None
     for row in rows:
-        opposite = EVERY_ROW[row][1]
-        results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=opposite)
-        if opposite:
+        results, preds = evaluate(trained.model, dataset, trained.normaliser, opposite=row.opposite)
+        if row.opposite:
             if self_results is None:
                 self_results, _ = evaluate(trained.model, dataset, trained.normaliser)
             results |= {s: self_results[s] for s in SHARED_WITH_SELF}
         else:
             self_results = results
-        cells[row], predictions[row] = results, preds
-    return {"training": training, "seed": seed, "seconds": trained.seconds, "cells": cells,
-            "predictions": predictions, "normaliser": trained.normaliser.state_dict(),
+        cells[row.name], predictions[row.name] = results, preds
+    return {"training": training.name, "seed": seed, "seconds": trained.seconds, "cells": cells,
+            "predictions": predictions, "profile": prof.to_dict(), "normaliser": trained.normaliser.state_dict(),
             "made_on": f"{platform.node()}, cache {cache_dir()}"}
 
 
-def check_made_on(result: dict, dataset: PGAEDataset, prof: Profile, folder: Path) -> None:
+def check_made_on(result: dict, dataset: PGAEDataset, folder: Path) -> None:
     """Raise :class:`~pgae_lite.train.checkpoint.DataMismatchError` unless the unit's model was trained
     on ``dataset`` (the caller's): the same statistics of its training samples, on any machine."""
-    cfg = prof.train
-    fitted = Normaliser.fit(training_split(dataset, cfg.max_train_samples), cfg.vision_scaling).state_dict()
+    cfg = result["profile"]["train"]
+    fitted = Normaliser.fit(training_split(dataset, cfg["max_train_samples"]), cfg["vision_scaling"]).state_dict()
     check_trained_on({"normaliser": result["normaliser"]}, fitted, folder,
                      f"{dataset.source}; the model was trained on {result['made_on']}")
 
 
-__all__ = ["SHARED_WITH_SELF", "check_made_on", "remember_dataset", "table1_unit", "unit_profile",
-           "worker_dataset"]
+__all__ = ["SHARED_WITH_SELF", "check_made_on", "remember_dataset", "table1_unit", "worker_dataset"]

@@ -3,7 +3,8 @@
 A checkpoint holds the model's weights (with whatever its language encoder keeps beside them,
 e.g. the free-form variant's word lookup), the optimiser, the random generators, the history,
 the recipe (``Profile.to_dict()``, with its version) and the normaliser fitted on the training
-samples: :func:`load_model` rebuilds the same model from it, and refuses data it was not trained on.
+samples: :func:`pgae_lite.runs.pipeline.load_model` rebuilds the same model from it
+(:func:`check_recipe_version`, :func:`load_weights`), and refuses data it was not trained on.
 """
 from __future__ import annotations
 
@@ -12,12 +13,12 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
+from torch import nn
+
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.model.pgae import PGAE
-from pgae_lite.train.config import saved_model_config
+from pgae_lite.train.config import RECIPE_VERSION
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import (CheckpointMismatchError, CorruptCheckpointError, default_device, load_torch,
+from pgae_lite.util.storage import (CheckpointMismatchError, CorruptCheckpointError, load_torch,
                                     save_torch)
 
 CHECKPOINT = "checkpoint.pt"
@@ -36,7 +37,7 @@ def training_split(dataset: PGAEDataset, max_samples: int | None = None) -> PGAE
     return train_set.subset(slice(0, max_samples)) if max_samples else train_set
 
 
-def save_checkpoint(path: Path, model: PGAE, optimiser: torch.optim.Optimizer, gen: torch.Generator,
+def save_checkpoint(path: Path, model: nn.Module, optimiser: torch.optim.Optimizer, gen: torch.Generator,
                     epoch: int, history: list[dict], profile, normaliser: Normaliser,
                     seconds: float) -> None:
     """Write a checkpoint atomically (a crash mid-write never leaves a broken file).
@@ -79,29 +80,26 @@ def check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "
             "other features; or train the model again on this data (another output folder).")
 
 
-def load_model(path: str | Path, device: torch.device | str | None = None,
-               dataset: PGAEDataset | None = None) -> tuple[PGAE, Normaliser, dict]:
-    """Model (in eval mode), normaliser and the checkpoint's other contents.
+def check_recipe_version(recipe, path: str | Path) -> dict:
+    """``recipe`` (a checkpoint's saved ``Profile.to_dict()``) if it was trained with this :data:`RECIPE_VERSION`;
+    else a :class:`~pgae_lite.util.storage.CheckpointMismatchError` that says so."""
+    version = recipe.get("recipe_version") if isinstance(recipe, dict) else None
+    if version != RECIPE_VERSION:
+        raise CheckpointMismatchError(
+            f"{path} was trained with recipe version {version or 'before versions'}; this pgae_lite reads "
+            f"version {RECIPE_VERSION} (an option's meaning or default changed since): train the model again")
+    return recipe
 
-    With ``dataset``, first check that the model was trained on it: the
-    normaliser fitted on its training samples must equal the one saved. The
-    visual features come from a CAE, and two CAEs (e.g. trained with another
-    number of threads, in another cache) give different features: a model fed
-    another CAE's features produces nonsense without any error, so this
-    raises :class:`DataMismatchError` instead.
-    """
-    ckpt = load_torch(path, ("model", "profile", "normaliser"))
-    if dataset is not None:
-        cfg = ckpt["profile"]["train"]
-        fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
-                                cfg.get("vision_scaling", "global")).state_dict()
-        check_trained_on(ckpt, fitted, path, dataset.source)
+
+def load_weights(model: nn.Module, ckpt: dict, path: str | Path) -> nn.Module:
+    """``model`` with the checkpoint's weights: refused with a one-sentence error if any is NaN or infinite
+    (:class:`~pgae_lite.util.storage.CorruptCheckpointError`), or if they do not fit the model
+    (:class:`~pgae_lite.util.storage.CheckpointMismatchError`: another model's, or altered)."""
     broken = [k for k, v in ckpt["model"].items() if torch.is_tensor(v) and v.is_floating_point()
               and not torch.isfinite(v).all()]
     if broken:
         raise CorruptCheckpointError(f"{path} holds non-finite weights (NaN or infinite) in {', '.join(broken[:3])}"
                                      f"{' ...' if len(broken) > 3 else ''}: the model cannot be used; train it again")
-    model = build_pgae(saved_model_config(ckpt["profile"], path))
     try:
         model.load_state_dict(ckpt["model"])
     except (RuntimeError, TypeError, AttributeError) as e:    # weights of another shape, another model's names
@@ -109,9 +107,17 @@ def load_model(path: str | Path, device: torch.device | str | None = None,
         raise CheckpointMismatchError(f"{path} holds weights that do not fit the model its recipe describes "
                                       f"({first[:160]}): it was written by another version of the package or "
                                       "altered; train the model again") from None
-    model.to(device or default_device()).eval()
-    return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
+    return model
 
 
-__all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "load_checkpoint", "load_model",
-           "save_checkpoint", "training_split"]
+def check_fitted_on(ckpt: dict, dataset: PGAEDataset, path: str | Path) -> None:
+    """Raise :class:`DataMismatchError` unless the checkpoint's model was trained on ``dataset``: the normaliser
+    fitted on its training samples (with the saved recipe's subset and scaling) equals the one saved."""
+    cfg = ckpt["profile"]["train"]
+    fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
+                            cfg.get("vision_scaling", "global")).state_dict()
+    check_trained_on(ckpt, fitted, path, dataset.source)
+
+
+__all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "check_fitted_on", "check_recipe_version",
+           "check_trained_on", "load_checkpoint", "load_weights", "save_checkpoint", "training_split"]

@@ -7,11 +7,11 @@ are paired, and their code reads "x% supervised" as a share of *updates*: each b
 paired with probability x, while the loader reshuffles every epoch, so every sample is seen
 paired now and then. A fixed labelled subset of x% of the *samples* is the other reading::
 
-    | TrainConfig         | a paired step                     | the other steps                     |
-    |---------------------|-----------------------------------|-------------------------------------|
-    | paired_share = x    | a batch, with probability x       | the batch: repeat action / language |
-    | labelled_share = x  | a sample of the fixed x% subset   | the other samples: the same two     |
-    | both None (default) | every sample draws from signal_probs (7/9 of the draws paired)          |
+    | TrainConfig.supervision            | a paired step                   | the other steps                     |
+    |------------------------------------|---------------------------------|-------------------------------------|
+    | SupervisionConfig(x, of="updates") | a batch, with probability x     | the batch: repeat action / language |
+    | SupervisionConfig(x, of="samples") | a sample of the fixed x% subset | the other samples: the same two     |
+    | None (default)                     | every sample draws from signal_probs (7/9 of the draws paired)        |
 
 Within each kind a signal keeps its weight in ``TrainConfig.signal_probs``: describe 3/7,
 execute 3/7, repeat both 1/7 when paired; repeat action and repeat language 1/2 each otherwise.
@@ -20,10 +20,35 @@ from __future__ import annotations
 
 import torch
 
+from dataclasses import dataclass
+from typing import ClassVar
+
+from pgae_lite.model.config import Part
 from pgae_lite.model.signals import DESCRIBE, EXECUTE, REPEAT_ACTION, REPEAT_BOTH, REPEAT_LANGUAGE, sample_signals
 
+#: What a share counts: the PTAE authors' reading (a share of the updates), or a fixed labelled subset.
+READINGS = ("updates", "samples")
 PAIRED = (DESCRIBE, EXECUTE, REPEAT_BOTH)           # need the action and its description together
 UNIMODAL = (REPEAT_ACTION, REPEAT_LANGUAGE)          # need one of them only
+
+
+@dataclass(frozen=True)
+class SupervisionConfig(Part):
+    """Limited supervision (``TrainConfig.supervision``): a ``share`` in (0, 1] of the updates, or of the training
+    samples, is paired (see the module)."""
+
+    kind: ClassVar[str] = "supervision"
+    share: float
+    of: str = "updates"
+
+    def __post_init__(self):
+        ok = not isinstance(self.share, bool) and isinstance(self.share, (int, float)) and 0 < self.share <= 1
+        if not ok:
+            raise ValueError(f"SupervisionConfig share must be a number in (0, 1], the paired share; "
+                             f"got {self.share!r}")
+        if self.of not in READINGS:
+            raise ValueError(f"SupervisionConfig of must be one of {', '.join(READINGS)} (a share of the updates, "
+                             f"or a fixed share of the samples); got {self.of!r}")
 
 
 def restricted(probs: tuple[float, ...], keep: tuple[int, ...]) -> tuple[float, ...]:
@@ -46,18 +71,19 @@ def labelled_samples(count: int, share: float, seed: int) -> torch.Tensor:
 def draw_signals(size: int, gen: torch.Generator, cfg, labelled: torch.Tensor | None = None) -> torch.Tensor:
     """The signals of one batch of ``size`` samples under ``cfg`` (a TrainConfig), (size,).
 
-    ``labelled`` (size,) bool: which of the batch's samples are in the labelled subset
-    (with ``cfg.labelled_share``). With neither share set, exactly the recipe's draws.
+    ``labelled`` (size,) bool: which of the batch's samples are in the labelled subset (a share
+    of the samples). Without ``cfg.supervision``, exactly the recipe's draws.
     """
-    if cfg.paired_share is not None:                        # a share of the updates is paired
-        paired = torch.rand(1, generator=gen).item() < cfg.paired_share
+    supervision = cfg.supervision
+    if supervision is not None and supervision.of == "updates":      # a share of the updates is paired
+        paired = torch.rand(1, generator=gen).item() < supervision.share
         probs = restricted(cfg.signal_probs, PAIRED if paired else UNIMODAL)
         return sample_signals(size, gen, cfg.signals_per_sample, probs)
     signals = sample_signals(size, gen, cfg.signals_per_sample, cfg.signal_probs)
-    if cfg.labelled_share is None:
+    if supervision is None:
         return signals
     unimodal = sample_signals(size, gen, cfg.signals_per_sample, restricted(cfg.signal_probs, UNIMODAL))
     return torch.where(labelled, signals, unimodal)         # an unlabelled sample: one modality at a time
 
 
-__all__ = ["PAIRED", "UNIMODAL", "draw_signals", "labelled_samples", "restricted"]
+__all__ = ["PAIRED", "READINGS", "SupervisionConfig", "UNIMODAL", "draw_signals", "labelled_samples", "restricted"]

@@ -1,7 +1,7 @@
 """Argument checks of the public functions: whole numbers in a range, types, devices.
 
 No paper section: plumbing for the command line, :mod:`~pgae_lite.runs.reproduce`,
-:mod:`~pgae_lite.evaluate` and the playground. Each check returns the value it
+:mod:`~pgae_lite.evaluate.table1` and the playground. Each check returns the value it
 accepts, or raises one sentence that names the argument, the value given and
 what is allowed (:class:`~pgae_lite.util.errors.ArgumentError`, or
 :class:`~pgae_lite.util.errors.ArgumentTypeError` for a wrong type).

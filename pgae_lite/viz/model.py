@@ -32,7 +32,7 @@ def plot_gates(gates_by_signal: Mapping[str, np.ndarray | torch.Tensor], title: 
 
     ``gates_by_signal`` maps a signal name to gate values of shape (N, hidden),
     e.g. ``{s: p.gate for s, p in predictions.items()}`` from
-    :func:`pgae_lite.evaluate.evaluate`. z near 1 lets the action features
+    :func:`pgae_lite.evaluate.table1.evaluate`. z near 1 lets the action features
     through, z near 0 the language features (h = z ⊙ A_h + (1 − z) ⊙ L_h).
     """
     names = list(gates_by_signal)
@@ -154,7 +154,7 @@ def wrong_words(expected: str, generated: str) -> str:
 
 
 def prediction_frame(pred, data: PGAEDataset) -> pd.DataFrame:
-    """One row per sample of a :class:`pgae_lite.evaluate.Predictions` on ``data`` (same order).
+    """One row per sample of a :class:`pgae_lite.evaluate.table1.Predictions` on ``data`` (same order).
 
     Columns: id, code (the authors' label, e.g. ``PUSH-L-SLOW``), action, side,
     speed, arrangement, expected (the first of the 8 descriptions, or "" where
@@ -232,7 +232,7 @@ def plot_mean_gates(groups: Mapping[str, Mapping[str, np.ndarray | torch.Tensor]
 def word_confusion(pred, data: PGAEDataset, slot: str = "action") -> pd.DataFrame:
     """Counts of expected (rows) against generated (columns) word at one position of a description.
 
-    ``pred`` is a :class:`pgae_lite.evaluate.Predictions` of a signal that outputs a
+    ``pred`` is a :class:`pgae_lite.evaluate.table1.Predictions` of a signal that outputs a
     description (``describe``, ``repeat language``) on ``data`` (same order); ``slot``
     is ``"action"``, ``"colour"`` or ``"speed"``. Words are counted as their canonical
     form (``move-up`` counts as ``push``). A generated text with too few words or a

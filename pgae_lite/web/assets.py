@@ -32,11 +32,11 @@ import numpy as np
 import torch
 
 from pgae_lite.bert.pretrained import fixed_token_rows, tokens_to_text
-from pgae_lite.config import get_profile
+from pgae_lite.config import Profile
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
 from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
-from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
-from pgae_lite.runs.trainings import PHRASINGS
+from pgae_lite.runs.pipeline import profile_of, simulated_dataset, trained_cae, trained_model
+from pgae_lite.runs.rows import TRAININGS
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
 from pgae_lite.web.free_text import export_free_text
@@ -47,7 +47,7 @@ from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY
 
 #: The models the playground offers, by the name the page shows, and their trainings.
-MODELS = {"PGAE": "PGAE", "PGAE-BERT": "PGAE-BERT", "PGAE-BERT-phrasings": PHRASINGS}
+MODELS = {name: TRAININGS[name] for name in ("PGAE", "PGAE-BERT", "PGAE-BERT-phrasings")}
 
 
 def _arm() -> dict:
@@ -86,7 +86,7 @@ def _frames(out: Path, test: PGAEDataset, config) -> str:
     pattern of their names in ``out`` (``{episode}``: an id without ``sim/``; ``{which}``: first or last)."""
     from matplotlib.image import imsave
 
-    from pgae_lite.data.simulated import load_episode
+    from pgae_lite.sim.dataset import load_episode
 
     make_folder(out / "frames")
     for sample, steps in zip(map(str, test.ids), test.lengths.tolist()):
@@ -99,21 +99,22 @@ def _frames(out: Path, test: PGAEDataset, config) -> str:
     return "frames/{episode}-{which}.png"
 
 
-def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progress: bool = False,
+def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool = False,
                simulate: bool = True, half: bool = True) -> dict:
     """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
     ``simulate=False``: without the simulator's runs (the page then keeps the cubes where they lay);
     ``half=False``: the sentence encoder's weights in float32 (:func:`~pgae_lite.web.free_text.export_free_text`)."""
+    prof = profile_of(profile)
     out = make_folder(out)
     make_folder(out / "models")
-    prof = get_profile(profile)
-    data = simulated_dataset(prof.name, "cpu", progress=progress)
+    data = simulated_dataset(prof, "cpu", progress=progress)
+    trained = {name: trained_model(training, prof, seed, device="cpu", progress=progress)
+               for name, training in MODELS.items()}
     models, encoders, normaliser = {}, {}, None
     # the fixed inputs the playground's signals read (not "repeat both", a training signal)
     rows = fixed_token_rows()
     rows = rows[rows[:, 0] != SIGNAL_TOKEN + SIGNALS.index("repeat both")]          # (581, 5)
-    for name, training in MODELS.items():
-        run = trained_pgae(training, prof.name, seed, device="cpu", progress=progress)
+    for name, run in trained.items():
         model = run.model.cpu().eval()
         if normaliser is not None and normaliser != run.normaliser:
             raise ValueError(f"{name} was trained with other data units than the first model: the page holds "
@@ -147,7 +148,9 @@ def export_web(out: str | Path, profile: str | None = None, seed: int = 0, progr
         "sim_runs": "sim_runs.json" if simulate else None, "frames": frames,
     }
     if simulate:
-        simulator_runs(out, MODELS, prof.name, seed, progress=progress)
+        cae, _ = trained_cae(prof, "cpu", progress=progress)          # NICO's eye: frame -> 30 features
+        simulator_runs(out, trained, data.split("test"), cae, prof.data, {"profile": prof.name, "seed": seed},
+                       progress=progress)
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
 

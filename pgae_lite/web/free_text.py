@@ -67,8 +67,8 @@ def export_free_text(out: Path, encoders: dict, entries: dict, half: bool = True
         entries[name] |= {"head": f"models/{name}.head.onnx", "words": None,
                           "refusals": f"models/{name}.refusals.json",
                           # the tuned variant reads a text it was trained on from its frozen table (encode_texts)
-                          "fixed_from_table": getattr(encoder, "top", None) is not None}
-        if getattr(encoder, "word_lookup", None) is not None:
+                          "fixed_from_table": encoder.fixed_from_table}
+        if encoder.word_lookup is not None:
             atomic_write_text(out / "models" / f"{name}.words.json", _compact(word_table(encoder.word_lookup)))
             entries[name]["words"] = f"models/{name}.words.json"
     files = ["models/transformer.onnx", "refusals.json", "tokenizer/tokenizer.json", "tokenizer/vocab.txt",

@@ -1,6 +1,6 @@
 """What the robot refuses, as data for the reader's browser (not in the paper).
 
-Paper, Sec. 3: PGAE-BERT reads any text and always acts. :mod:`pgae_lite.robot.refusals` decides
+Paper, Sec. 3: PGAE-BERT reads any text and always acts. :mod:`pgae_lite.freeform.refusals` decides
 first whether the robot acts on a free instruction, from its words, the model's readback and the
 scene, reading the phrase lexicon and WordNet. The page has neither, so the build writes what the
 rule reads, and ``book/_js/pgae.js`` applies the same rule to it::
@@ -23,9 +23,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from pgae_lite.bert.phrasings import phrase_table
-from pgae_lite.bert.word_lookup import WordLookup, wordnet
-from pgae_lite.robot import refusals
+from pgae_lite.freeform.phrasings import phrase_table
+from pgae_lite.freeform.word_lookup import WordLookup, wordnet
+from pgae_lite.freeform import refusals
 from pgae_lite.web.word_table import candidates
 from pgae_lite.world.words import COLOURS
 

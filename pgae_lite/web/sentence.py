@@ -6,7 +6,7 @@ has a head, its own top layer and pooling, that turns those token vectors into t
 PGAE's GMU reads::
 
     transformer   input_ids, attention_mask (1, L)  -> below_top (1, L, D)
-    head          below_top (1, L, D), mask (1, L)  -> features (1, D_f)
+    head          below_top (1, L, D), mask (1, L)  -> features (1, D_f)   the encoder's ``export_head()``:
                   the paper's PGAE-BERT: the pretrained top layer, then the mean over the tokens
                   the free-form variant: its tuned top layer, then its attention pooling
 
@@ -24,7 +24,6 @@ import torch
 from torch import nn
 
 from pgae_lite.bert.pretrained import input_text
-from pgae_lite.bert.tuned_layer import TunedTopLayer
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.util.storage import atomic_write
 from pgae_lite.world.words import decode
@@ -40,26 +39,6 @@ class TransformerGraph(nn.Module):
     def forward(self, input_ids: torch.Tensor, attention_mask: torch.Tensor) -> torch.Tensor:
         out = self.transformer(input_ids=input_ids, attention_mask=attention_mask, output_hidden_states=True)
         return out.hidden_states[-2]               # the top layer's output is not used: the export drops it
-
-
-class HeadGraph(nn.Module):
-    """One PGAE-BERT model's features from the token vectors below the top layer of one text (no padding):
-    its top layer (the tuned one, or a copy of the pretrained one), then its pooling."""
-
-    def __init__(self, encoder: nn.Module):
-        super().__init__()
-        self.attention = getattr(encoder, "attention", None)      # the variant's attention pooling
-        if self.attention is None and getattr(encoder, "pooling", "mean") != "mean":
-            raise ValueError(f"the page pools tokens by their mean; this encoder pools by {encoder.pooling!r}")
-        tuned = getattr(encoder, "top", None)
-        self.top = (tuned if tuned is not None else TunedTopLayer(encoder.transformer)).eval()
-
-    def forward(self, below_top: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
-        last = self.top(below_top, mask.bool())                             # (1, L, D), the top layer
-        if self.attention is None:                                          # the paper's: the mean
-            weight = mask[..., None].float()                                # (1, L, 1)
-            return (last * weight).sum(1) / weight.sum(1)                   # f = Σ_t x_t / L
-        return self.attention(last, mask.bool())                            # f = 1/K Σ_k Σ_t a_tk x_t
 
 
 def _export(module: nn.Module, example: tuple, names: list[str], outputs: list[str], dynamic: dict) -> bytes:
@@ -111,11 +90,14 @@ def transformer_onnx(transformer: nn.Module, path=None, half: bool = True) -> by
 
 
 def head_onnx(encoder: nn.Module, path=None, half: bool = True) -> bytes:
-    """One PGAE-BERT model's :class:`HeadGraph` as ONNX bytes (weights in float16 if ``half``), written to
-    ``path`` if given."""
+    """One PGAE-BERT model's head (its language encoder's ``export_head()``) as ONNX bytes (weights in float16
+    if ``half``), written to ``path`` if given."""
+    head = encoder.export_head()
+    if head is None:
+        raise ValueError(f"{type(encoder).__name__} reads no free text: it has no head for the page")
     D = encoder.transformer.model.config.hidden_size
     example = (torch.zeros(1, 4, D), torch.ones(1, 4, dtype=torch.long))
-    data = _export(HeadGraph(encoder), example, ["below_top", "mask"], ["features"],
+    data = _export(head, example, ["below_top", "mask"], ["features"],
                    {"below_top": {1: "tokens"}, "mask": {1: "tokens"}})
     data = half_weights(data) if half else data
     if path is not None:
@@ -137,7 +119,7 @@ def sentence_features(encoder: nn.Module, transformer_bytes: bytes, head_bytes: 
     out = []
     for text in texts:
         read = input_text(signal, encoder.read_as(text))
-        if getattr(encoder, "top", None) is not None and read in fixed:
+        if encoder.fixed_from_table and read in fixed:
             with torch.no_grad():
                 out.append(encoder.encode_texts([read]).cpu().numpy()[0])
             continue
@@ -166,7 +148,7 @@ def free_text_reference(model: nn.Module, normaliser, test, texts: list[str], ro
     """What PyTorch computes for ``texts[i]`` typed on test episode ``rows[i]`` (default ``i mod N``) under
     execute, as :func:`~pgae_lite.robot.playground.play` computes it (what the page must give): the words,
     the readback under repeat language, and the joints in the data's units (steps, 5), step 0 the start.
-    (Whether the robot acts on the text is :func:`pgae_lite.robot.refusals.refusal`'s to say.)"""
+    (Whether the robot acts on the text is :func:`pgae_lite.freeform.refusals.refusal`'s to say.)"""
     model.eval()
     tensors = normaliser.tensors(test)
     rows = torch.arange(len(texts)) % len(test) if rows is None else torch.as_tensor(rows)
@@ -182,5 +164,5 @@ def free_text_reference(model: nn.Module, normaliser, test, texts: list[str], ro
              "joints": joints[i, :int(test.lengths[int(r)])].cpu().numpy()} for i, r in enumerate(rows)]
 
 
-__all__ = ["HeadGraph", "TransformerGraph", "free_text_reference", "half_weights", "head_onnx", "sentence_features",
+__all__ = ["TransformerGraph", "free_text_reference", "half_weights", "head_onnx", "sentence_features",
            "sentence_parity", "transformer_onnx"]

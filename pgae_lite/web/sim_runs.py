@@ -25,10 +25,10 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from pgae_lite.config import get_profile
+from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.data.dataset import PGAEDataset, description_text
 from pgae_lite.robot.closedloop import closed_loop, variation_of
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.util.storage import atomic_write_text, make_folder
 
 LABEL = ("Run in the pybullet simulator when this book was built, closed loop: "
@@ -52,35 +52,27 @@ def _values(array: np.ndarray) -> list:
     return np.round(np.asarray(array, dtype=np.float64), DECIMALS).tolist()
 
 
-def simulator_runs(out: str | Path, models: dict, profile: str | None = None, seed: int = 0,
-                   progress: bool = False) -> dict:
-    """Run every model of ``models`` (the page's name -> its training, :data:`~pgae_lite.web.assets.MODELS`)
-    closed loop on :func:`chosen_episodes`;
-    write ``out/sim_runs.json`` (see the module docstring) and return its content.
-
-    The models, the CAE and the dataset come from the cache (trained there when missing), as for
-    :func:`~pgae_lite.web.assets.export_web`.
-    """
+def simulator_runs(out: str | Path, trained: dict, test: PGAEDataset, cae: ChannelSeparatedCAE,
+                   config: DatasetConfig, label: dict, progress: bool = False) -> dict:
+    """Run every model of ``trained`` (the page's name -> its trained model,
+    :func:`~pgae_lite.web.assets.export_web`'s) closed loop on :func:`chosen_episodes` of ``test``, with NICO's
+    eye ``cae`` in the scenes ``config`` records; write ``out/sim_runs.json`` (see the module docstring, with
+    ``label``'s profile and seed) and return its content."""
     out = make_folder(out)
-    prof = get_profile(profile)
-    data = simulated_dataset(prof.name, "cpu", progress=progress)
-    cae, _ = trained_cae(prof.name, "cpu", progress=progress)         # NICO's eye: frame -> 30 features
-    test = data.split("test")
     rows = chosen_episodes(test)
     runs = []
-    for name, training in models.items():
-        trained = trained_pgae(training, prof.name, seed, device="cpu", progress=progress)
-        model = trained.model.cpu().eval()
+    for name, run_of in trained.items():
+        model = run_of.model.cpu().eval()
         for i in tqdm(rows, desc=f"{name}, closed loop", unit="ep", disable=not progress):
             said = description_text(test.descriptions[i, 0])        # the manifest's description
-            run = closed_loop(model, cae, trained.normaliser, int(test.pattern[i]), variation_of(test.ids[i]),
-                              said, config=prof.data)
+            run = closed_loop(model, cae, run_of.normaliser, int(test.pattern[i]), variation_of(test.ids[i]),
+                              said, config=config)
             runs.append({"model": name, "episode": str(test.ids[i]), "signal": "execute", "kind": "closed loop",
                          "description": said, "passed": bool(run.passed),
                          "joints": _values(run.joints),             # (T, 5)
                          "measured": _values(run.measured),         # (T, 5)
                          "cubes": _values(run.cubes)})              # (T, 2, 3)
-    result = {"label": LABEL, "profile": prof.name, "seed": seed, "runs": runs}
+    result = {"label": LABEL, **label, "runs": runs}
     atomic_write_text(out / "sim_runs.json", json.dumps(result))
     return result
 

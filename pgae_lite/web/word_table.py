@@ -1,7 +1,7 @@
 """The free-form variant's word lookup as a table, for the reader's browser (not in the paper).
 
 Paper, Sec. 3: PGAE-BERT reads free text. The free-form variant first rewrites each word its
-training never held to the training word WordNet gives it (:mod:`pgae_lite.bert.word_lookup`:
+training never held to the training word WordNet gives it (:mod:`pgae_lite.freeform.word_lookup`:
 ``amethyst`` -> ``purple``). The page has no WordNet, so it reads the words through a table made
 at build time from the model's own lookup::
 
@@ -20,7 +20,7 @@ import json
 import re
 from functools import lru_cache
 
-from pgae_lite.bert.word_lookup import WordLookup, wordnet
+from pgae_lite.freeform.word_lookup import WordLookup, wordnet
 from pgae_lite.util.storage import atomic_write_text, cache_dir, config_digest, make_folder
 
 # The words of a text, as the lookup splits them (word_lookup._WORD); the page's pattern is the same

@@ -1,4 +1,4 @@
-"""The lexicon of :mod:`pgae_lite.bert.phrasings`: the words of each slot, by meaning.
+"""The lexicon of :mod:`pgae_lite.freeform.phrasings`: the words of each slot, by meaning.
 
 Not from the paper (training-time language augmentation for PGAE-BERT, Sec. 3).
 Written from general English for this purpose, not from any test sentence:
@@ -112,8 +112,12 @@ def held_out_words(lexicon: "PhraseLexicon | None" = None) -> tuple[str, ...]:
     return tuple(held)
 
 
+#: Which words a training's phrasings use: the whole lexicon, or less held_out_words().
+PHRASING_WORDS = ("all", "held-out")
+
+
 def training_lexicon(phrasing_words: str = "all") -> "PhraseLexicon":
-    """The lexicon a training's phrasings use (``TrainConfig.phrasing_words``): all of it, or less
+    """The lexicon a training's phrasings use (``PhrasingsConfig.words``): all of it, or less
     :func:`held_out_words`."""
     return LEXICON.without(*held_out_words()) if phrasing_words == "held-out" else LEXICON
 
@@ -220,4 +224,5 @@ LEXICON = PhraseLexicon(
 )
 
 
-__all__ = ["LEXICON", "MEANINGS", "PhraseLexicon", "SLOTS", "held_out_words", "training_lexicon", "words_of"]
+__all__ = ["LEXICON", "MEANINGS", "PHRASING_WORDS", "PhraseLexicon", "SLOTS", "held_out_words", "training_lexicon",
+           "words_of"]

@@ -46,7 +46,7 @@ from collections import Counter
 from dataclasses import asdict
 from functools import lru_cache
 
-from pgae_lite.bert.phrase_lexicon import SLOTS, PhraseLexicon, words_of
+from pgae_lite.freeform.phrase_lexicon import SLOTS, PhraseLexicon, words_of
 from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 #: Function words: never looked up (the closed classes of English, written for this purpose).
@@ -96,7 +96,7 @@ def base_forms(word: str) -> set[str]:
 class WordLookup:
     """Rewrites the unknown words of a text to training words of the meaning WordNet gives them.
 
-    ``lexicon``: the training's phrase lexicon (:func:`pgae_lite.bert.phrase_lexicon.training_lexicon`);
+    ``lexicon``: the training's phrase lexicon (:func:`pgae_lite.freeform.phrase_lexicon.training_lexicon`);
     ``sentences``: the training's sentences (the phrasing bank's), whose every word is known.
     """
 

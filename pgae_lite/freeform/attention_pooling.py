@@ -18,30 +18,37 @@ the encoder's only trained parameters. As in PGAE-BERT, the token vectors of the
 text runs through the transformer. With ``tuned=True`` (ModelConfig.tuned_top_layer),
 free text, any text outside the 869, reads the transformer's top layer trained
 (:mod:`pgae_lite.bert.tuned_layer`) before the pooling. A training on phrasings gives
-the encoder a ``word_lookup`` (:mod:`pgae_lite.bert.word_lookup`): free text's words
-that training never held are first looked up in WordNet. Used by the free-form
-variant ``PGAE-BERT-phrasings`` (:data:`pgae_lite.runs.trainings.PHRASINGS`), never by the
-paper's PGAE-BERT.
+the encoder its ``word_lookup`` (:meth:`AttentivePretrainedEncoder.learn_words`,
+:mod:`pgae_lite.freeform.word_lookup`): free text's words that training never held are first
+looked up in WordNet. ``ModelConfig(language=AttentionConfig(tuned_top_layer=True))`` builds it:
+the free-form variant ``PGAE-BERT-phrasings`` (:mod:`pgae_lite.runs.rows`), never the paper's PGAE-BERT.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
 
 import torch
 from torch import nn
 
+from pgae_lite.bert.config import check_model, check_words
 from pgae_lite.bert.pretrained import (
     Transformer,
+    cached_token_vectors,
     check_texts,
     check_token_ids,
     fixed_inputs,
     load_transformer,
     model_name,
+    padded_token_vectors,
     table_rows,
-    token_vectors,
     tokens_to_text,
 )
-from pgae_lite.bert.tuned_layer import TunedTopLayer
-from pgae_lite.bert.word_lookup import WordLookup
-from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
+from pgae_lite.bert.tuned_layer import TopLayerHead, TunedTopLayer
+from pgae_lite.freeform.word_lookup import WordLookup
+from pgae_lite.model.config import Part, flag
+from pgae_lite.model.language import LanguageEncoderBase
+from pgae_lite.world.words import DEFAULT_LEXICON, Lexicon
 
 #: Attention heads (K). Deviation from paper: chosen on generated validation sentences
 #: (experiments/validation_readback.py's grammar seed), never on the test paraphrases.
@@ -63,37 +70,27 @@ class AttentionPooling(nn.Module):
         return torch.einsum("btk,btd->bd", a, states) / a.shape[-1]  # f = 1/K Σ_k Σ_t a_tk x_t
 
 
-def padded_token_vectors(tf: Transformer, texts: list[str],
-                         top_input: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
-    """Texts -> token vectors (B, T, D) and mask (B, T), padded to the longest text, on the CPU.
+@dataclass(frozen=True)
+class AttentionConfig(Part):
+    """The free-form variant's encoder (``ModelConfig.language``): the transformer ``model`` (None: the default
+    the project ships) read through a trained attention pooling; with ``tuned_top_layer``, free text reads the
+    transformer's top layer tuned."""
 
-    ``top_input``: the top layer's input (:func:`~pgae_lite.bert.pretrained.token_vectors`), not its output."""
-    pieces = list(token_vectors(tf, texts, top_input=top_input))
-    longest = max((h.shape[1] for h, _ in pieces), default=1)
-    states = torch.cat([nn.functional.pad(h, (0, 0, 0, longest - h.shape[1])) for h, _ in pieces])
-    mask = torch.cat([nn.functional.pad(m, (0, longest - m.shape[1])) for _, m in pieces])
-    return states, mask
+    kind: ClassVar[str] = "pretrained-attention"
+    model: str | None = None
+    tuned_top_layer: bool = False
 
+    def __post_init__(self):
+        check_model("AttentionConfig", self.model)
+        flag("AttentionConfig", "tuned_top_layer", self.tuned_top_layer)
 
-def cached_token_vectors(tf: Transformer, texts: list[str], what: str, dtype: torch.dtype = torch.float32,
-                         top_input: bool = False) -> tuple[torch.Tensor, torch.Tensor]:
-    """:func:`padded_token_vectors`, kept on disk under a digest of the texts and the model."""
-    key = config_digest({"texts": texts, "encoder": tf.digest, "dtype": str(dtype)})
-    path = cache_dir() / "embeddings" / f"{what}-{'top-input' if top_input else 'tokens'}-{key}.pt"
-    if path.exists():
-        try:
-            saved = load_torch(path, ("states", "mask"), what=f"{what} token cache")
-            if saved["states"].shape[:2] == saved["mask"].shape and saved["states"].isfinite().all():
-                return saved["states"], saved["mask"]
-        except CorruptCheckpointError:       # damaged: computed again, never trusted
-            pass
-    states, mask = padded_token_vectors(tf, texts, top_input)
-    states = states.to(dtype)
-    save_torch({"states": states, "mask": mask}, path)               # atomic write
-    return states, mask
+    def build(self, lexicon: Lexicon = DEFAULT_LEXICON) -> LanguageEncoderBase:
+        """The encoder these settings describe, for a model of ``lexicon``'s words (the paper's)."""
+        check_words(lexicon)
+        return AttentivePretrainedEncoder(self.model, tuned=self.tuned_top_layer)
 
 
-class AttentivePretrainedEncoder(nn.Module):
+class AttentivePretrainedEncoder(LanguageEncoderBase):
     """Frozen pretrained transformer -> token vectors -> trained attention pooling -> (B, output_dim).
 
     Called like PGAE-BERT's :class:`~pgae_lite.bert.pretrained.PretrainedLanguageEncoder`:
@@ -118,9 +115,20 @@ class AttentivePretrainedEncoder(nn.Module):
         # free text only: the top layer, trained (tuned_layer.py); None = frozen
         self.top = TunedTopLayer(self.transformer) if tuned else None
         self._row_of_text = {text: i for i, text in enumerate(self.texts)}
-        # given by a training on phrasings (phrasing_bank.for_training), saved with the weights (get_extra_state):
+        # learnt with a training on phrasings (learn_words), saved with the weights (get_extra_state):
         # free text's unknown words looked up first (word_lookup.py)
         self.word_lookup: WordLookup | None = None
+        # a text it was trained on (a description, e.g. said back) reads the frozen layer's output, as in training
+        self.fixed_from_table = tuned
+
+    def learn_words(self, lexicon, sentences: list[str]) -> None:
+        """Know the words of a training's phrasings: ``lexicon``'s phrases and the ``sentences`` themselves; free
+        text's other words are looked up in WordNet first (:class:`~pgae_lite.freeform.word_lookup.WordLookup`)."""
+        self.word_lookup = WordLookup(lexicon, sentences)
+
+    def export_head(self) -> nn.Module:
+        """The page's head: the top layer (tuned, or a copy of the pretrained one), then the attention pooling."""
+        return TopLayerHead(self.top if self.top is not None else TunedTopLayer(self.transformer), self.attention)
 
     def get_extra_state(self) -> dict:
         """Saved in the state dict beside the weights: the word lookup, as plain strings."""
@@ -203,5 +211,4 @@ class AttentivePretrainedEncoder(nn.Module):
         return f"{self.name!r}, pooling='attention', output_dim={self.output_dim}, {tuned}"
 
 
-__all__ = ["AttentionPooling", "AttentivePretrainedEncoder", "HEADS", "cached_token_vectors",
-           "padded_token_vectors"]
+__all__ = ["AttentionConfig", "AttentionPooling", "AttentivePretrainedEncoder", "HEADS"]

@@ -10,6 +10,13 @@
 
 Signals that take a description in (execute, repeat language) feed test
 sample i its alternative i mod 8, so every synonym is used equally often.
+
+One evaluation for every model: a model says what it writes for each signal (``model.PATHS``:
+words, joints or both), and a cell it has no path for is N.A., ``None``. PGAE and PTAE write both
+for every signal; PRAE and PVAE, configured per direction, one each (paper Sec. 4: PVAE "cannot
+output joint values when it is configured to be used for action-to-language translation", and
+executing "is not trained to generate descriptions (<EOS> in this case)";
+:mod:`pgae_lite.model.prae`).
 """
 from __future__ import annotations
 
@@ -19,7 +26,6 @@ import numpy as np
 import torch
 
 from pgae_lite.data.dataset import Normaliser, PGAEDataset
-from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_OUT, make_batch, signal_ids
 from pgae_lite.util.checks import instance_of, positive_number, whole_number
 from pgae_lite.util.errors import ArgumentError
@@ -51,7 +57,7 @@ class Predictions:
     gate: np.ndarray       # (N, hidden) GMU gate values ((N, 0): a model without a gate, e.g. PTAE)
 
 
-def check_model_inputs(model: PGAE, data: PGAEDataset, normaliser: Normaliser) -> None:
+def check_model_inputs(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser) -> None:
     """A one-sentence ArgumentTypeError unless the three are what their names say."""
     instance_of("model", model, torch.nn.Module, "a model (a PGAE, a torch.nn.Module)")
     instance_of("data", data, PGAEDataset, "a PGAEDataset")
@@ -60,10 +66,13 @@ def check_model_inputs(model: PGAE, data: PGAEDataset, normaliser: Normaliser) -
 
 
 @torch.no_grad()
-def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
+def predict(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser, signal: str,
             opposite: bool = False, batch_size: int = 256,
             tensors: dict[str, torch.Tensor] | None = None, language: torch.Tensor | None = None) -> Predictions:
     """Run ``model`` on every sample of ``data`` with one signal (decoders free-running).
+
+    What the model has no path for stays empty: no text (``""``) where it writes no words, joints of NaN
+    where it writes no joints (``model.PATHS``).
 
     ``tensors``: ``normaliser.tensors(data, device)`` when the caller has them already.
     ``language`` (N, D): precomputed language features, one row per sample, in place of
@@ -95,9 +104,11 @@ def predict(model: PGAE, data: PGAEDataset, normaliser: Normaliser, signal: str,
             out = model(batch)                               # decoders free-running, greedy words
         else:
             out = model(batch, language=language[s:s + len(index)].to(device))
-        texts += [decode(row, lexicon) for row in out["logits"].argmax(-1).cpu()]
-        pred = torch.cat([batch.start_joints[:, None], out["joints"]], 1)        # (B, T, 5)
-        target = torch.cat([batch.start_joints[:, None], batch.joint_target], 1)
+        target = torch.cat([batch.start_joints[:, None], batch.joint_target], 1)    # (B, T, 5)
+        texts += ([decode(row, lexicon) for row in out["logits"].argmax(-1).cpu()] if "logits" in out
+                  else [""] * len(index))
+        pred = (torch.cat([batch.start_joints[:, None], out["joints"]], 1) if "joints" in out
+                else torch.full_like(target, float("nan")))                             # (B, T, 5)
         joints.append(normaliser.joints_to_data(pred).cpu().numpy())
         targets.append(normaliser.joints_to_data(target).cpu().numpy())
         gates.append(out["gate"].cpu().numpy() if "gate" in out else np.zeros((len(index), 0), np.float32))
@@ -125,10 +136,11 @@ def nrmse(pred: Predictions, joint_range: float) -> tuple[float, float]:
     return 100 * float(np.sqrt(mse_valid)) / joint_range, 100 * float(np.sqrt(mse_padded)) / joint_range
 
 
-def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str = "test",
+def evaluate(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser, split: str = "test",
              opposite: bool = False, joint_range: float | None = None
-             ) -> tuple[dict[str, dict[str, float]], dict[str, Predictions]]:
-    """Table 1 cells for the four test signals: accuracy, nRMSE and padded nRMSE (all %).
+             ) -> tuple[dict[str, dict[str, float | None]], dict[str, Predictions]]:
+    """Table 1 cells for the four test signals: accuracy, nRMSE and padded nRMSE (all %), None where the
+    model has no path for them (N.A., ``model.PATHS``).
 
     ``joint_range`` defaults to the observed range over the whole dataset.
     """
@@ -142,8 +154,9 @@ def evaluate(model: PGAE, data: PGAEDataset, normaliser: Normaliser, split: str 
     results, preds = {}, {}
     for signal in TEST_SIGNALS:
         p = predict(model, subset, normaliser, signal, opposite=opposite, tensors=tensors)
-        err, err_padded = nrmse(p, joint_range)
-        results[signal] = {"accuracy": 100 * float(p.correct.mean()), "nrmse": err,
+        writes = model.PATHS[signal]
+        err, err_padded = nrmse(p, joint_range) if "joints" in writes else (None, None)
+        results[signal] = {"accuracy": 100 * float(p.correct.mean()) if "words" in writes else None, "nrmse": err,
                            "nrmse_padded": err_padded, "n": int(len(p.correct))}
         preds[signal] = p
     return results, preds

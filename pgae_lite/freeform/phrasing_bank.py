@@ -3,11 +3,10 @@
 Paper, Sec. 3: PGAE-BERT's pretrained encoder "has the potential to recognise
 unseen natural language", but trained on the dataset's three-word descriptions
 alone it reads a free-form instruction as something far from anything it was
-trained on. With ``TrainConfig.phrasings`` = K > 0, every sample whose signal
-takes a description (execute, repeat both, repeat language; or those of
-``TrainConfig.phrasing_signals``) reads, with probability
-``TrainConfig.phrasing_prob``, one of K sentences that say its
-description in other words (:func:`pgae_lite.bert.phrasings.phrasings`, a grammar
+trained on. With ``TrainConfig.phrasings`` = :class:`PhrasingsConfig` (K per meaning), every
+sample whose signal takes a description (execute, repeat both, repeat language; or those of
+its ``signals``) reads, with probability ``prob``, one of K sentences that say its
+description in other words (:func:`pgae_lite.freeform.phrasings.phrasings`, a grammar
 and lexicon written for the purpose, independent of the held-out test
 sentences) instead of the description itself. The targets stay the dataset's
 words. The transformer stays frozen (up to its top layer, when that is tuned:
@@ -15,28 +14,60 @@ words. The transformer stays frozen (up to its top layer, when that is tuned:
 signal are encoded once (``S x 36 x K`` sentences for S signals) and kept on
 disk like its table of fixed inputs. A training step then adds only what comes
 after the cache for the picked sentences: a lookup of their sentence vectors
-for the mean; for the attention pooling (:mod:`pgae_lite.bert.attention_pooling`)
+for the mean; for the attention pooling (:mod:`pgae_lite.freeform.attention_pooling`)
 the trained attention over their cached token vectors, and before it the tuned
 top layer, if there is one, over the cached input of that layer.
 """
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
+from typing import ClassVar
 
 import torch
 
-from pgae_lite.bert.attention_pooling import AttentivePretrainedEncoder
-from pgae_lite.bert.phrase_lexicon import PhraseLexicon, training_lexicon
-from pgae_lite.bert.word_lookup import WordLookup
-from pgae_lite.bert.phrasings import phrasings
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.bert.tuned_layer import TRAIN_EVERY
+from pgae_lite.freeform.attention_pooling import AttentivePretrainedEncoder
+from pgae_lite.freeform.phrase_lexicon import PHRASING_WORDS, PhraseLexicon, training_lexicon
+from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.model.config import Part, whole
 from pgae_lite.model.signals import LANG_IN, SignalBatch
 from pgae_lite.util.storage import cache_dir, config_digest, load_torch, save_torch
 from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
 
 MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
 TEXT_SIGNALS = tuple(s for s in range(len(SIGNALS)) if LANG_IN[s])   # execute, repeat both, repeat language
+#: The signals that take a description, and so may read phrasings (PhrasingsConfig.signals).
+PHRASING_SIGNALS = tuple(SIGNALS[s] for s in TEXT_SIGNALS)
+
+
+@dataclass(frozen=True)
+class PhrasingsConfig(Part):
+    """A training on phrasings (``TrainConfig.phrasings``): ``per_meaning`` sentences K of every instruction, read
+    with probability ``prob`` by the samples of ``signals``; ``words``: "all" of the lexicon, or "held-out",
+    less :func:`~pgae_lite.freeform.phrase_lexicon.held_out_words` (see the module)."""
+
+    kind: ClassVar[str] = "phrasings"
+    per_meaning: int = 60
+    # Chosen on generated validation sentences (experiments/validation_readback.py), never on the test
+    # paraphrases (experiments/HISTORY.md).
+    prob: float = 0.75
+    words: str = "all"
+    signals: tuple[str, ...] = PHRASING_SIGNALS
+
+    def __post_init__(self):
+        whole("PhrasingsConfig", "per_meaning", self.per_meaning, 1)
+        if isinstance(self.prob, bool) or not isinstance(self.prob, (int, float)) or not 0 < self.prob <= 1:
+            raise ValueError(f"PhrasingsConfig prob must be a number in (0, 1], the chance that a sample with a "
+                             f"description reads a phrasing instead; got {self.prob!r}")
+        if self.words not in PHRASING_WORDS:
+            raise ValueError(f"PhrasingsConfig words must be one of {', '.join(PHRASING_WORDS)}; got {self.words!r}")
+        signals = tuple(self.signals) if isinstance(self.signals, (list, tuple)) else ()
+        if not signals or not set(signals) <= set(PHRASING_SIGNALS):
+            raise ValueError(f"PhrasingsConfig signals must name one or more of {', '.join(PHRASING_SIGNALS)}; "
+                             f"got {self.signals!r}")
+        object.__setattr__(self, "signals", signals)
 
 
 class PhrasingBank:
@@ -110,16 +141,16 @@ class PhrasingBank:
         return base.index_put((rows.to(base.device),), said)
 
 
-def for_training(encoder: torch.nn.Module, cfg) -> PhrasingBank | None:
-    """The bank a training (``cfg``: its TrainConfig) reads phrasings from, or None when it reads none.
+def for_training(model: torch.nn.Module, config: PhrasingsConfig, seed: int) -> PhrasingBank:
+    """The bank a training on phrasings (``config``, the recipe's ``seed``) reads its language from: what the
+    caller hands the training loop (:func:`pgae_lite.train.loop.train`'s ``language``) for ``model``.
 
-    Gives the free-form variant's encoder its word lookup, built from the same lexicon and
-    sentences (:mod:`pgae_lite.bert.word_lookup`); the encoder saves it with its weights.
+    The free-form variant's encoder learns the words of the same lexicon and sentences (its word lookup,
+    :meth:`~pgae_lite.freeform.attention_pooling.AttentivePretrainedEncoder.learn_words`), saved with its weights.
     """
-    if not cfg.phrasings:
-        return None
-    lexicon = training_lexicon(cfg.phrasing_words)
-    bank = PhrasingBank(encoder, cfg.phrasings, cfg.seed, lexicon, cfg.phrasing_signals, cfg.phrasing_prob)
+    encoder = model.language_encoder
+    lexicon = training_lexicon(config.words)
+    bank = PhrasingBank(encoder, config.per_meaning, seed, lexicon, config.signals, config.prob)
     if isinstance(encoder, AttentivePretrainedEncoder):       # words never trained on: WordNet first
-        encoder.word_lookup = WordLookup(lexicon, bank.texts)
+        encoder.learn_words(lexicon, bank.texts)
     return bank

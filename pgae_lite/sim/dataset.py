@@ -44,7 +44,7 @@ from pgae_lite.sim.record import Episode, SimConfig, record_episode
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.util.storage import (array_digest, atomic_write, atomic_write_text, cache_dir, config_digest,
                                     make_folder)
-from pgae_lite.world.colours import DEFAULT_WORLD, World
+from pgae_lite.world.colours import DEFAULT_WORLD, PAPER_PATTERNS, World
 
 #: Bump when the simulator changes what it records: old caches are then not reused.
 GENERATOR_VERSION = 4
@@ -91,6 +91,18 @@ class DatasetConfig:
     def key(self) -> str:
         """Short digest of the config (and the generator version): the cache folder's name."""
         return config_digest({"version": GENERATOR_VERSION, **self.to_dict()})
+
+    def parts(self) -> list["DatasetConfig"]:
+        """The recordings this dataset is made of, each in a cache folder of its own: with a world beyond the
+        paper's, its patterns that the paper's world has are the paper's recordings (the same episodes, the
+        paper's folder untouched), the rest the world's own; else the dataset itself."""
+        patterns = self.pattern_list()
+        paper = [p for p in patterns if p < PAPER_PATTERNS]
+        new = tuple(p for p in patterns if p >= PAPER_PATTERNS)
+        if self.world is None or not paper:
+            return [self]
+        own = replace(self, world=None, patterns=None if paper == list(range(PAPER_PATTERNS)) else tuple(paper))
+        return [own] + ([replace(self, patterns=new)] if new else [])
 
 
 class CorruptEpisodeError(PGAELiteError, RuntimeError):
@@ -211,6 +223,13 @@ def generate(config: DatasetConfig | None = None, workers: int | None = None,
     Safe to interrupt and to call again; damaged files are recorded again.
     """
     config = config or DatasetConfig()          # the book's (its profiles: pgae_lite.config)
+    if len(config.parts()) > 1:                 # the paper's recordings, then a new world's own
+        reports = [generate(part, workers, progress) for part in config.parts()]
+        episodes = sum(r.episodes for r in reports)
+        first_try = sum(r.first_try * r.episodes for r in reports) / episodes
+        return GenerationReport(reports[-1].folder, episodes, sum(r.recorded for r in reports),
+                                sum(r.corrupt for r in reports), first_try, sum(r.seconds for r in reports),
+                                sum(r.megabytes for r in reports))
     t0 = time.perf_counter()
     folder = episode_folder(config)
     make_folder(folder)
@@ -276,19 +295,21 @@ def load_episode(config: DatasetConfig, pattern: int, variation: int = 0) -> Epi
         raise ValueError(f"episode (pattern {pattern}, variation {variation}) is not in this dataset: "
                          f"patterns {config.pattern_list()[0]}..{config.pattern_list()[-1]}, "
                          f"variations 0..{config.variations - 1}")
-    path = episode_folder(config) / f"{episode_name(pattern, variation)}.npz"
+    part = next(c for c in config.parts() if pattern in c.pattern_list())
+    path = episode_folder(part) / f"{episode_name(pattern, variation)}.npz"
     if not path.exists():
-        generate(config)
-    return load_episode_file(path, config.world)
+        generate(part)
+    return load_episode_file(path, part.world)
 
 
 def iter_episodes(config: DatasetConfig, split: str | None = None) -> Iterator[Episode]:
     """Every episode of the dataset in order (``split``: ``"train"``, ``"test"`` or all)."""
     generate(config, progress=False)
-    for p, v in config.episodes():
-        if split is None or config.the_world.pattern(p).is_test == (split == "test"):
-            path = episode_folder(config) / f"{episode_name(p, v)}.npz"
-            yield load_episode_file(path, config.world)
+    for part in config.parts():
+        for p, v in part.episodes():
+            if split is None or part.the_world.pattern(p).is_test == (split == "test"):
+                path = episode_folder(part) / f"{episode_name(p, v)}.npz"
+                yield load_episode_file(path, part.world)
 
 
 def training_frames(config: DatasetConfig, stride: int = 4, views: tuple[str, ...] = ("images", "images_opposite")

@@ -7,8 +7,8 @@ instruction is checked before the robot acts on it, from what the model
 understood of it and from the scene (the two cubes on the table):
 
 - its words as the model's language reads them: the text after the encoder's word
-  lookup (:mod:`pgae_lite.bert.word_lookup`), if it has one, and in it the phrases of the training
-  lexicon (:func:`pgae_lite.bert.phrasings.slot_meanings`): the actions, colours and
+  lookup (:mod:`pgae_lite.freeform.word_lookup`), if it has one, and in it the phrases of the training
+  lexicon (:func:`pgae_lite.freeform.phrasings.slot_meanings`): the actions, colours and
   speeds it names;
 - the model's own readback (``repeat language``): the description it took the text to mean.
 
@@ -33,9 +33,9 @@ import re
 from dataclasses import replace
 from functools import lru_cache
 
-from pgae_lite.bert.phrase_lexicon import MEANINGS, PhraseLexicon, training_lexicon, words_of
-from pgae_lite.bert.phrasings import phrasings, slot_meanings
-from pgae_lite.bert.word_lookup import WordLookup, wordnet
+from pgae_lite.freeform.phrase_lexicon import MEANINGS, PhraseLexicon, training_lexicon, words_of
+from pgae_lite.freeform.phrasings import phrasings, slot_meanings
+from pgae_lite.freeform.word_lookup import WordLookup, wordnet
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import COLOURS, LanguageError, parse_description
 
@@ -56,7 +56,7 @@ class CannotDo(LanguageError):
 
 def lookup_of(encoder) -> WordLookup:
     """The lookup that reads a text's words for ``encoder``: its own, or one that knows the training words."""
-    own = getattr(encoder, "word_lookup", None)
+    own = encoder.word_lookup
     return _words_only() if own is None else own
 
 
@@ -72,7 +72,7 @@ def _reading(encoder, text: str) -> tuple[WordLookup, str, dict[str, str]]:
 
     An encoder with its own word lookup reads the text through it; one without reads it as it is.
     """
-    own = getattr(encoder, "word_lookup", None)
+    own = encoder.word_lookup
     if own is None:
         return _words_only(), text, {}
     return own, own.rewrite(text), own.replacements(text)

@@ -7,16 +7,16 @@ natural language". Trained only on the dataset's three-word descriptions
 encoder's sentence vectors of free-form instructions land far from those it
 was trained on. Not from the paper: this module says each instruction in many
 ways for training, from a grammar and a lexicon written for the purpose, not
-from any test sentence (the held-out ones are in :mod:`pgae_lite.bert.paraphrases`).
+from any test sentence (the held-out ones are in :mod:`pgae_lite.freeform.paraphrases`).
 
 A sentence is a carrier (``NICO, ...``) around a politeness frame (``could
 you ...?``) around a clause in one of several word orders; the clause names
 the action (a verb, with an optional direction that matches it, or a plain
 verb such as ``move`` with a direction it then needs), the cube (determiner,
 colour, noun) and the speed (an adverb or phrase, before the verb, at the end,
-fronted, or an adjective). The words are in :mod:`pgae_lite.bert.phrase_lexicon`
-(:data:`~pgae_lite.bert.phrase_lexicon.LEXICON`);
-:meth:`~pgae_lite.bert.phrase_lexicon.PhraseLexicon.without` holds words out, to
+fronted, or an adjective). The words are in :mod:`pgae_lite.freeform.phrase_lexicon`
+(:data:`~pgae_lite.freeform.phrase_lexicon.LEXICON`);
+:meth:`~pgae_lite.freeform.phrase_lexicon.PhraseLexicon.without` holds words out, to
 measure sentences with words never seen in training. :func:`phrasings` gives n
 distinct sentences, the same for the same seed; :func:`slot_meanings` finds
 the lexicon's phrases in a text.
@@ -27,7 +27,7 @@ import itertools
 import random
 import re
 
-from pgae_lite.bert.phrase_lexicon import LEXICON, MEANINGS, SLOTS, PhraseLexicon, words_of
+from pgae_lite.freeform.phrase_lexicon import LEXICON, MEANINGS, SLOTS, PhraseLexicon, words_of
 from pgae_lite.util.checks import instance_of, whole_number
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.util.storage import config_digest
@@ -108,8 +108,8 @@ def phrasing(action: str, colour: str, speed: str, rng: random.Random,
     """One random sentence that tells NICO to do (action, colour, speed).
 
     ``rng`` is a ``random.Random``; ``lexicon`` (a
-    :class:`~pgae_lite.bert.phrase_lexicon.PhraseLexicon`) defaults to
-    :data:`~pgae_lite.bert.phrase_lexicon.LEXICON`.
+    :class:`~pgae_lite.freeform.phrase_lexicon.PhraseLexicon`) defaults to
+    :data:`~pgae_lite.freeform.phrase_lexicon.LEXICON`.
     """
     _check_meaning(action, colour, speed)
     instance_of("rng", rng, random.Random, "a random.Random")
