@@ -32,9 +32,9 @@ import torch
 from harness import Benchmark, side_by_side
 from pgae_lite.config import TRAININGS, Training, get_profile, training_profile
 from pgae_lite.data.original import load_original
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import evaluate, predict
-from pgae_lite.runs.opposite_scale import spread_of
+from pgae_lite.data.normaliser import spread_of
 from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
 from pgae_lite.train.loop import train
 

@@ -52,7 +52,7 @@ def main() -> None:
         if epoch % a.every and epoch != a.epochs:
             return
         t = time.perf_counter() - t0
-        from pgae_lite.data.dataset import Normaliser
+        from pgae_lite.data.normaliser import Normaliser
         norm = Normaliser.fit(ds.split("train"), prof.train.vision_scaling)
         res, _ = evaluate(model, ds, norm)
         line = {"epoch": epoch, "t": round(t), **{k: round(v["accuracy"], 2) for k, v in res.items()},

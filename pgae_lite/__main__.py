@@ -29,12 +29,12 @@ ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
 FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned", "PTAE")
 
 
-def simulate(profile: str | None = None, workers: int | None = None, progress: bool = True) -> int:
-    """Record the profile's simulated dataset (or complete it) and print what was done."""
-    from pgae_lite.config import get_profile
+def simulate(profile, workers: int | None = None, progress: bool = True) -> int:
+    """Record the simulated dataset of ``profile`` (a :class:`~pgae_lite.config.Profile`), or complete it, and
+    print what was done."""
     from pgae_lite.sim.dataset import generate
 
-    report = generate(get_profile(profile).data, workers=workers, progress=progress)
+    report = generate(profile.data, workers=workers, progress=progress)
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
           f"in {report.seconds:.1f} s, {report.corrupt} damaged files replaced; "
           f"valid on the first try: {100 * report.first_try:.1f}%")
@@ -118,13 +118,14 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    """Check the parsed arguments (before any data is read), then run the command."""
-    from pgae_lite.config import profile_name
+    """Check the parsed arguments (before any data is read), then run the command: the profile is resolved
+    once, here, and handed down as a value."""
+    from pgae_lite.config import get_profile
     from pgae_lite.util.checks import whole_number
     from pgae_lite.util.errors import ArgumentError
 
     try:                      # --profile is checked by argparse; this checks the environment variable too
-        profile = profile_name(args.profile)
+        profile = get_profile(args.profile)
     except ValueError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.original import load_original
 from pgae_lite.data.toy import toy_dataset
 

@@ -8,7 +8,7 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import PAPER_TABLE, Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.world.patterns import Pattern

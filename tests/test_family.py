@@ -94,7 +94,7 @@ def test_prae_rebuilds_each_modality_from_its_code_and_translates_only_across(to
 
 
 def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(toy_short):
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.prae import PRAE
     from pgae_lite.model.config import ModelConfig
 
@@ -128,7 +128,7 @@ def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(t
 
 def check_the_configured_cells(model, data, tensors):
     """Table 1's cells of a configured model: words or joints per signal, N.A. (None) for the rest."""
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.family.configured import configured_predictions, evaluate_configured
 
     normaliser = Normaliser.fit(data.split("train"))
@@ -171,7 +171,7 @@ def test_a_pvae_sample_is_the_mean_with_the_authors_small_noise():
 def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
     """Every step draws one of the 8 equivalent descriptions of each action; the cross path then
     describes each action with one of its 8 (the one-to-many translation PRAE was not made for)."""
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
     from pgae_lite.model.config import ModelConfig
 
@@ -224,7 +224,7 @@ def test_an_unknown_family_model_is_refused(toy_short):
 def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(toy_short):
     """The row as its text, looked up in the encoder's table; the encoder's weights never train."""
     from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, tokens_to_text
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.pvae import PVAE
     from pgae_lite.family.train import train_family
     from pgae_lite.model.config import ModelConfig
@@ -279,7 +279,7 @@ def test_family_models_trains_the_chapters_three_and_ptae_is_cached():
 def test_the_family_table_marks_na_and_gives_median_and_range(tmp_path, monkeypatch):
     import json
 
-    from pgae_lite.runs.family_table import family_frame
+    from pgae_lite.runs.tables import family_frame
 
     stats = {"median": 99.5, "min": 98.0, "max": 100.0}
     configured = {s: {"accuracy": stats if s in ("describe", "repeat language") else None,

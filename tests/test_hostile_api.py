@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 import pgae_lite
 from pgae_lite.config import PROFILE_ENV, get_profile, profile_name
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.util.errors import ArgumentError, ArgumentTypeError, PGAELiteError
 from pgae_lite.evaluate.table1 import Predictions, evaluate, format_table, nrmse, predict
 from pgae_lite.config import ModelConfig

@@ -109,7 +109,7 @@ def test_instruction_features_of_no_instruction_is_one_sentence():
 
 
 def test_the_playground_refuses_an_empty_dataset(toy):
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.pgae import PGAE
     from pgae_lite.robot.playground import Playground
 

@@ -83,7 +83,7 @@ def test_probe_reads_what_is_linearly_there_and_not_what_is_not():
 
 
 def test_which_cube_probe_runs_on_a_model(toy_short):
-    from pgae_lite.data.dataset import Normaliser
+    from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.plan import which_cube_probe
 
     normaliser = Normaliser.fit(toy_short.split("train"))

@@ -17,7 +17,7 @@ import torch
 from pgae_lite.bert.encoders import build_pgae
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
 from pgae_lite.robot.closedloop import pattern_for
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.robot.instructions import acted_on, instruction_features
 from pgae_lite.world.words import VOCABULARY, LanguageError

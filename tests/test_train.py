@@ -10,7 +10,7 @@ import pytest
 import torch
 
 from pgae_lite.config import PROFILE_ENV, PROFILES, ModelConfig, Profile, TrainConfig, get_profile
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError, load_checkpoint, load_model
 from pgae_lite.train.loss import lr_factor, pgae_loss

@@ -9,7 +9,7 @@ import pytest
 import torch
 from matplotlib.figure import Figure
 
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.toy import toy_dataset
 from pgae_lite.evaluate.table1 import Predictions
 from pgae_lite.model.signals import make_batch

@@ -9,7 +9,8 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.data.dataset import Normaliser, from_recordings
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import from_recordings
 from pgae_lite.sim.dataset import GENERATOR_VERSION, DatasetConfig
 from pgae_lite.evaluate.table1 import Predictions
 from pgae_lite.exercises import check_new_colour

@@ -1,12 +1,11 @@
-"""PGAE-BERT's pretrained language encoder, and the free-form language built on it (chapter 05).
+"""PGAE-BERT's pretrained language encoder (paper Sec. 3, chapter 05), frozen or its top layer tuned.
 
-- ``transformer``        the pretrained transformer, loaded offline once per process
-- ``pretrained``         the frozen transformer encoder of PGAE-BERT (paper Sec. 3)
-- ``attention_pooling``  the free-form variant's encoder: attention over the transformer's tokens
-- ``tuned_layer``        the transformer's top layer, tuned for free text
-- ``tuned_encoder``      the top layer tuned on every input, mean-pooled (PVAE-BERT's fine-tuning)
-- ``word_lookup``        words never trained on, looked up in WordNet
-- ``encoders``           any PGAE a ModelConfig names: the pretrained encoders passed in to the model
-- ``phrase_lexicon``, ``phrasings``, ``phrasing_bank``  generated ways of saying each instruction
-- ``paraphrases``        held-out free-form paraphrases of the test instructions
+- ``transformer``    the pretrained transformer, loaded offline once per process
+- ``tuned_layer``    the transformer's top layer as a module of its own, to tune, and the page's head on it
+- ``pretrained``     the frozen transformer encoder of PGAE-BERT, its table of fixed inputs, token vectors
+- ``tuned_encoder``  the top layer tuned on every input, mean-pooled (PVAE-BERT's fine-tuning)
+- ``config``         ``PretrainedConfig``: these encoders as a part of a recipe (``ModelConfig.language``)
+
+Free-form language built on it (the free-form variant, phrasings, the word lookup, refusals) is
+``pgae_lite.freeform``.
 """

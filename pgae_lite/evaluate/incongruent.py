@@ -26,7 +26,8 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import SIGNAL_TOKEN, make_batch, signal_ids
 from pgae_lite.world.patterns import pattern_number, pattern_parts
 from pgae_lite.world.words import (ACTIONS, CANONICAL, DEFAULT_LEXICON, SIGNALS, SLOTS, SYNONYMS, VOCABULARY,

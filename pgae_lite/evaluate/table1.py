@@ -25,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import LANG_OUT, make_batch, signal_ids
 from pgae_lite.util.checks import instance_of, positive_number, whole_number
 from pgae_lite.util.errors import ArgumentError

@@ -20,7 +20,7 @@ import torch
 from torch import nn
 
 from pgae_lite.model.config import ModelConfig
-from pgae_lite.data.dataset import Normaliser
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.world.words import SIGNALS, word_weights
 from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell
 from pgae_lite.model.pgae import PGAE, count_parameters

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import nrmse, predict
 from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
 from pgae_lite.world.colours import MIN_COLOUR_DIFFERENCE, World, nearest_seen

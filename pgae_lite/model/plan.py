@@ -31,7 +31,8 @@ from __future__ import annotations
 import torch
 from torch import nn
 
-from pgae_lite.data.dataset import JOINT_DIM, Normaliser, PGAEDataset
+from pgae_lite.data.dataset import JOINT_DIM, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH, make_batch, signal_ids
 from pgae_lite.world.patterns import Pattern
 

@@ -49,7 +49,8 @@ from tqdm.auto import tqdm
 
 from pgae_lite.cae import ChannelSeparatedCAE, extract_features
 from pgae_lite.config import PROFILES
-from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset, description_text
 from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.model.pgae import PGAE

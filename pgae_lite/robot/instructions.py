@@ -20,7 +20,8 @@ from tqdm.auto import tqdm
 from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.bert.pretrained import check_texts, input_text
 from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.model.pgae import PGAE

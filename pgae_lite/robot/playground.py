@@ -36,7 +36,8 @@ import torch
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.config import PROFILES
-from pgae_lite.data.dataset import Normaliser, PGAEDataset, description_text
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset, description_text
 from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids

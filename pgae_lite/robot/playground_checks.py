@@ -58,7 +58,7 @@ def check_playground(models, cae, data, config, every, signal, arrangement, acti
                             f"{', '.join(signals)}")
     if not len(data):
         raise ArgumentError("data holds no episodes: the playground needs a dataset with recordings to play, "
-                            "e.g. simulated_dataset('book')")
+                            "e.g. simulated_dataset(get_profile('book'))")
     recorded = sorted({pattern_parts(int(p))[1] for p in data.pattern})
     if arrangement is not None and arrangement_number(arrangement) not in recorded:
         raise ArgumentError(f"arrangement {arrangement} is not in this dataset; its "

@@ -31,7 +31,8 @@ import numpy as np
 
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from pgae_lite.config import Profile, recipe_from_dict
-from pgae_lite.data.dataset import DataFormatError, Normaliser, PGAEDataset
+from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.freeform.phrase_lexicon import training_lexicon
 from pgae_lite.freeform.phrasing_bank import for_training
 from pgae_lite.freeform.phrasings import phrasings_digest

@@ -184,8 +184,7 @@ def measured(name: str) -> str:
 
 
 def table1_rows(name: str) -> dict[str, dict]:
-    """The rows of a ``benchmarks/table1.py`` result, each a row of Table 1
-    (:data:`~pgae_lite.runs.rows.TABLE1_ROWS`)."""
+    """The rows of a ``benchmarks/table1.py`` result, each one of :data:`~pgae_lite.runs.rows.TABLE1_ROWS`."""
     data = load(name)["data"].get("rows")
     if not isinstance(data, dict) or not data:
         raise ResultFileError(f"{name}.json: data.rows must be an object with one entry per row of Table 1 "

@@ -20,7 +20,8 @@ import platform
 from pathlib import Path
 
 from pgae_lite.config import Profile
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.runs.pipeline import simulated_dataset, train_when_free, unit_profile
 from pgae_lite.runs.rows import Row, Training

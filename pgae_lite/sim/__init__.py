@@ -1,4 +1,4 @@
-"""Our tabletop simulator (pybullet): NICO, a table, two cubes and an opposite agent.
+"""Our tabletop simulator (pybullet): NICO, a table, two cubes and an opposite agent, and the dataset recorded in it.
 
 Paper, Sec. 4 (Dataset). The authors recorded their data in a Blender scene
 that is not public; this subpackage builds an equivalent world from code a
@@ -8,6 +8,7 @@ student can read, one concept per module:
 - ``scene``    table, cubes, both robots, NICO's eye camera and renderer
 - ``actions``  push / pull / slide as min-jerk hand paths through IK; the check
 - ``record``   episodes: both views, seeds and retries, determinism; ``Simulation``, ``Execution``
+- ``dataset``  the 864 simulated episodes: what to record, generation, cache, split (chapter 02)
 
 Quick start::
 

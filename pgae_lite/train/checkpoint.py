@@ -15,7 +15,8 @@ import torch
 
 from torch import nn
 
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.train.config import RECIPE_VERSION
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.util.storage import (CheckpointMismatchError, CorruptCheckpointError, load_torch,

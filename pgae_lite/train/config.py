@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from pgae_lite.data.dataset import check_vision_scaling
+from pgae_lite.data.normaliser import check_vision_scaling
 from pgae_lite.model.config import Part, flag, whole
 from pgae_lite.model.signals import SIGNAL_PROBS
 from pgae_lite.world.words import SIGNALS

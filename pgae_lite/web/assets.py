@@ -33,7 +33,8 @@ import torch
 
 from pgae_lite.bert.pretrained import fixed_token_rows, tokens_to_text
 from pgae_lite.config import Profile
-from pgae_lite.data.dataset import Normaliser, PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
 from pgae_lite.runs.pipeline import profile_of, simulated_dataset, trained_cae, trained_model
 from pgae_lite.runs.rows import TRAININGS

@@ -1,11 +1,14 @@
-"""The family's committed result files as tables: chapter 09 and the results page (A2) show them.
+"""The chapters' tables of committed result files: the family's (chapter 09, A2) and the two-view ablation (06, A2).
 
-PGAE paper, Sec. 2 and 4 (PRAE, PVAE, N.A.) and PTAE's experiments. Each reads a file that a
-benchmark wrote (:mod:`pgae_lite.runs.results`):
+PGAE paper, Sec. 2 and 4 (PRAE, PVAE, N.A.), PTAE's experiments, and Sec. 4's PGAE-self and
+PGAE-opposite. Each reads a file that a benchmark wrote (:mod:`pgae_lite.runs.results`):
 
 - ``family-original`` / ``family-ours`` (``benchmarks/family.py``): :func:`family_frame`;
 - ``limited_supervision`` (``benchmarks/limited_supervision.py``): :func:`limited_frame`;
-- ``incongruent`` (``benchmarks/incongruent.py``): :func:`conflict_frames`.
+- ``incongruent`` (``benchmarks/incongruent.py``): :func:`conflict_frames`;
+- ``opposite_scale-original`` / ``-ours`` (``benchmarks/opposite_scale.py``: the two-view model under three
+  scalings of the visual features, each view's spread by :func:`pgae_lite.data.normaliser.spread_of`):
+  :func:`ablation_frame`.
 """
 from __future__ import annotations
 
@@ -60,4 +63,30 @@ def conflict_frames() -> tuple[pd.DataFrame, pd.DataFrame]:
             action.rename_axis("action conflict (execute, nRMSE %)"))
 
 
-__all__ = ["cell_text", "conflict_frames", "family_frame", "limited_frame"]
+def _median_range(values: list[float]) -> str:
+    return f"{np.median(values):.1f} ({min(values):.1f}-{max(values):.1f})"
+
+
+def ablation_frame(runs: dict[str, list[dict]], labels: dict[str, str]) -> pd.DataFrame:
+    """One row per (dataset, scaling): describe on both views (median and range over the seeds), spread.
+
+    ``runs``: the ``runs`` of each result file by dataset ("original", "ours"); ``labels``: each
+    scaling's name in the table, in the table's order.
+    """
+    named = {"original": "the authors' data", "ours": "our data"}
+    rows = []
+    for source, mine in runs.items():
+        for scaling, label in labels.items():
+            chosen = [r for r in mine if r["scaling"] == scaling]
+            if not chosen:
+                continue
+            rows.append({"data": named.get(source, source), "scaling": label, "seeds": len(chosen),
+                         "PGAE-self describe (%)": _median_range(
+                             [r["table1"]["self"]["describe"]["accuracy"] for r in chosen]),
+                         "PGAE-opposite describe (%)": _median_range(
+                             [r["table1"]["opposite"]["describe"]["accuracy"] for r in chosen]),
+                         "spread": round(chosen[0]["opposite_spread"], 2)})
+    return pd.DataFrame(rows).set_index(["data", "scaling"])
+
+
+__all__ = ["ablation_frame", "cell_text", "conflict_frames", "family_frame", "limited_frame"]

@@ -1,0 +1,12 @@
+"""Free-form language: reading instructions said in any words, and refusing what the robot cannot do (appendix A4).
+
+Not in the paper, which says PGAE-BERT "has the potential to recognise unseen natural language".
+
+- ``phrase_lexicon``     the words and phrases the generated sentences use, and those held out
+- ``phrasings``          generated ways of saying each instruction
+- ``word_lookup``        words never trained on, looked up in WordNet
+- ``attention_pooling``  the free-form variant's encoder: attention over the transformer's tokens; ``AttentionConfig``
+- ``phrasing_bank``      training on phrasings: the bank of their sentence vectors; ``PhrasingsConfig``
+- ``paraphrases``        held-out free-form paraphrases of the test instructions
+- ``refusals``           what the robot will not do with a free instruction, and says instead
+"""
