@@ -175,11 +175,11 @@ def _with_parts(settings: dict, parts: tuple[str, ...], where: str) -> dict:
     out = dict(settings)
     for name in parts:
         if out.get(name) is not None:
-            part = dict(out[name])
-            kind = part.pop("kind", None)
+            kind = out[name].get("kind")
             if kind not in PART_KINDS:
                 raise ValueError(f"{where}: unknown part {name}={kind!r}; the parts are: {', '.join(PART_KINDS)}")
-            out[name] = PART_KINDS[kind](**part)
+            settings = {f.name for f in fields(PART_KINDS[kind])}       # not what its dict adds (kind, digests)
+            out[name] = PART_KINDS[kind](**{k: v for k, v in out[name].items() if k in settings})
     return out
 
 

@@ -30,8 +30,8 @@ from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import SIGNAL_TOKEN, make_batch, signal_ids
 from pgae_lite.world.patterns import pattern_number, pattern_parts
-from pgae_lite.world.words import (ACTIONS, CANONICAL, DEFAULT_LEXICON, SIGNALS, SLOTS, SYNONYMS, VOCABULARY,
-                                   WORD_INDEX, decode, equivalent_descriptions, is_correct)
+from pgae_lite.world.words import (ACTIONS, CANONICAL, DEFAULT_LEXICON, DESCRIPTIONS, SIGNALS, SLOTS, SYNONYMS,
+                                   VOCABULARY, WORD_INDEX, decode, equivalent_descriptions, is_correct)
 
 LANGUAGE_CONFLICTS = ("action", "colour", "speed")      # which word of the description is swapped
 ACTION_CONFLICTS = ("action", "position", "speed")      # what differs in the recording shown
@@ -93,8 +93,8 @@ def incongruent_cells(model, data: PGAEDataset, normaliser: Normaliser, seed: in
     rng = np.random.default_rng(seed)
     out = {"language": {}, "action": {}, "n": len(test)}
     for kind in ("none", *LANGUAGE_CONFLICTS):
-        b = make_batch(tensors, index, signal_ids("describe", len(test)), index % 8)
-        words = data.descriptions[test, test % 8]                                    # (n, 3)
+        b = make_batch(tensors, index, signal_ids("describe", len(test)), index % DESCRIPTIONS)
+        words = data.descriptions[test, test % DESCRIPTIONS]                                    # (n, 3)
         read = words if kind == "none" else np.stack([swapped_words(w, kind, rng) for w in words])
         b.lang_tokens = torch.cat([torch.full((len(test), 1), SIGNAL_TOKEN + SIGNALS.index("describe")),
                                    torch.as_tensor(read), torch.zeros(len(test), 1, dtype=torch.long)], 1).to(device)
@@ -105,7 +105,7 @@ def incongruent_cells(model, data: PGAEDataset, normaliser: Normaliser, seed: in
         out["language"][kind] = {"described right": 100 * float(np.mean(right)),
                                  "said the words read": 100 * float(np.mean(followed))}
     for kind in ("none", *ACTION_CONFLICTS):
-        b = make_batch(tensors, index, signal_ids("execute", len(test)), index % 8)
+        b = make_batch(tensors, index, signal_ids("execute", len(test)), index % DESCRIPTIONS)
         shown = test if kind == "none" else shown_instead(data, test, kind, rng)
         b.action_input = torch.cat([tensors["vision"][shown], tensors["joints"][shown]], 2)   # (n, T, 35)
         b.action_lengths = tensors["lengths"][shown]                                        # the whole recording

@@ -30,7 +30,8 @@ from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import LANG_OUT, make_batch, signal_ids
 from pgae_lite.util.checks import instance_of, positive_number, whole_number
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, TEST_SIGNALS, decode, is_correct, normalise_signal
+from pgae_lite.world.words import (DEFAULT_LEXICON, DESCRIPTIONS, SIGNALS, TEST_SIGNALS, decode, is_correct,
+                                   normalise_signal)
 
 #: The paper's Table 1: (accuracy %, nRMSE %) per row and signal.
 PAPER_TABLE: dict[str, dict[str, tuple[float, float]]] = {
@@ -99,7 +100,7 @@ def predict(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser, s
     texts, joints, targets, gates = [], [], [], []
     for s in range(0, n, batch_size):
         index = torch.arange(s, min(n, s + batch_size))
-        batch = make_batch(tensors, index, signal_ids(signal, len(index)), index % 8,
+        batch = make_batch(tensors, index, signal_ids(signal, len(index)), index % DESCRIPTIONS,
                            torch.full((len(index),), opposite))
         if language is None:
             out = model(batch)                               # decoders free-running, greedy words

@@ -21,7 +21,7 @@ from torch import nn
 
 from pgae_lite.model.config import ModelConfig
 from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.world.words import SIGNALS, word_weights
+from pgae_lite.world.words import DESCRIPTIONS, SIGNALS, word_weights
 from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell
 from pgae_lite.model.pgae import PGAE, count_parameters
 from pgae_lite.model.signals import SIGNAL_PROBS, make_batch, sample_signals
@@ -208,7 +208,7 @@ def check_bottleneck(factory: Callable[[int, int, int], nn.Module], cell: str = 
     model.gmu = gmu                                          # in place of the GMU; PGAE.encode calls self.gmu
     toy = toy_dataset(1, seed, patterns=[0, 7, 80, 101, 140])  # five recordings, 100 or 50 steps
     batch = make_batch(Normaliser.fit(toy).tensors(toy), torch.arange(5), signal=torch.arange(5),  # one each
-                       alternative=torch.arange(5) % 8)
+                       alternative=torch.arange(5) % DESCRIPTIONS)
     out = _call(result, "PGAE with it", lambda: model(batch, teacher_language=True))
     if out is RAISED:
         return result

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import ClassVar
 
 import torch
@@ -30,7 +31,7 @@ from pgae_lite.bert.pretrained import input_text
 from pgae_lite.bert.tuned_layer import TRAIN_EVERY
 from pgae_lite.freeform.attention_pooling import AttentivePretrainedEncoder
 from pgae_lite.freeform.phrase_lexicon import PHRASING_WORDS, PhraseLexicon, training_lexicon
-from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.freeform.phrasings import phrasings, phrasings_digest
 from pgae_lite.model.config import Part, whole
 from pgae_lite.model.signals import LANG_IN, SignalBatch
 from pgae_lite.util.storage import cache_dir, config_digest, load_torch, save_torch
@@ -68,6 +69,16 @@ class PhrasingsConfig(Part):
             raise ValueError(f"PhrasingsConfig signals must name one or more of {', '.join(PHRASING_SIGNALS)}; "
                              f"got {self.signals!r}")
         object.__setattr__(self, "signals", signals)
+
+    def to_dict(self) -> dict:
+        """Its settings, and which sentences its grammar and lexicon give (a digest of those of seed 0): an edited
+        grammar or lexicon changes the recipe, so a model trained on other sentences is never reused."""
+        return super().to_dict() | {"sentences": _sentences_digest(self.per_meaning, self.words)}
+
+
+@lru_cache(maxsize=8)
+def _sentences_digest(per_meaning: int, words: str) -> str:
+    return phrasings_digest(per_meaning, 0, training_lexicon(words))
 
 
 class PhrasingBank:

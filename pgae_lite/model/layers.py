@@ -152,7 +152,7 @@ class FusedLSTM(nn.Module):
         hs, cs, inp = [], [], x_t
         for layer in range(self.num_layers):
             weights = [getattr(self.lstm, f"{n}_l{layer}") for n in ("weight_ih", "weight_hh", "bias_ih", "bias_hh")]
-            h, c = torch._VF.lstm_cell(inp, (h0[layer], c0[layer]), *weights)
+            h, c = torch.lstm_cell(inp, (h0[layer], c0[layer]), *weights)
             hs.append(h)
             cs.append(c)
             inp = h

@@ -75,9 +75,9 @@ class LanguageEncoder(LanguageEncoderBase):
     def forward(self, tokens: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         if self.signal_shift:                                   # signal 23 + s -> V + s
             tokens = torch.cat([tokens[:, :1] + self.signal_shift, tokens[:, 1:]], 1)
-        x = nn.functional.one_hot(tokens, self.input_dim).float()   # (B, 5, 28)
+        x = nn.functional.one_hot(tokens, self.input_dim).float()   # (B, 5, words + 5 signals)
         _, state = self.rnn(x, lengths)
-        return state_to_vector(state)                           # (B, 400)
+        return state_to_vector(state)                           # (B, 2 · layers · units)
 
 
 class ActionEncoder(nn.Module):
@@ -94,7 +94,7 @@ class ActionEncoder(nn.Module):
     def forward(self, inputs: torch.Tensor, lengths: torch.Tensor) -> torch.Tensor:
         k = self.stride                                         # inputs (B, T, 35), lengths (B,)
         _, state = self.rnn(inputs[:, ::k], lstm_steps_of(lengths, k))   # (B, ceil(T/k), 35)
-        return state_to_vector(state)                           # (B, 400)
+        return state_to_vector(state)                           # (B, 2 · layers · units)
 
 
 class LanguageDecoder(nn.Module):
@@ -125,13 +125,13 @@ class LanguageDecoder(nn.Module):
         bos[..., 0] = 1.0
         if target is not None:
             words = nn.functional.one_hot(target[:, :-1], self.words).float()
-            x = torch.cat([bos, words], 1)                      # (B, 4, 23)
+            x = torch.cat([bos, words], 1)                      # (B, 4, words)
             y, _ = self.rnn(x, None, state)
             return self.out(y)
         x, logits = bos[:, 0], []
         for _ in range(steps):
             y, state = self.rnn.step(x, state)
-            logit = self.out(y)                                 # (B, 23)
+            logit = self.out(y)                                 # (B, words)
             logits.append(logit)
             x = (logit.softmax(-1) if feedback == "soft"
                  else nn.functional.one_hot(logit.argmax(-1), self.words).float())
@@ -209,25 +209,16 @@ class ActionDecoder(nn.Module):
 
     def _free_running(self, state, vision: torch.Tensor, start: torch.Tensor,
                       steps: torch.Tensor | None) -> torch.Tensor:
-        B, S, _ = vision.shape
-        if steps is None:
-            steps = torch.full((B,), S, device=vision.device)
-        order = torch.argsort(steps.cpu(), descending=True, stable=True)      # longest first
-        active = (steps.cpu()[order][None] > torch.arange(S)[:, None]).sum(1).tolist()  # (S,) samples still running
-        order = order.to(vision.device)
-        vision, start = vision[order], start[order]
-        state = (state[0][:, order], state[1][:, order])
+        # The paper's decoder: ĵ_{t+1} = step(v_t, ĵ_t), one step at a time, every sample until the longest one
+        # ends (forward sets what comes after a sample's own last step to 0).
+        S = vision.shape[1]
+        longest = S if steps is None else int(steps.max())
         j, outs = start, []
-        for t, v_t in enumerate(vision.unbind(1)):              # S x (B, 30)
-            n = active[t]
-            if n == 0:
-                break
-            state = (state[0][:, :n], state[1][:, :n])
-            j, state = self.step(state, v_t[:n], j[:n], start[:n])   # ĵ_{t+1}, (n, 5k)
-            outs.append(nn.functional.pad(j, (0, 0, 0, B - n)))
-        joints = torch.stack(outs, 1)                           # (B, S', 5k), S' <= S
-        joints = nn.functional.pad(joints, (0, 0, 0, S - joints.shape[1]))
-        return torch.empty_like(joints).index_copy_(0, order, joints)   # back to the batch's order
+        for v_t in vision[:, :longest].unbind(1):                 # longest x (B, 30)
+            j, state = self.step(state, v_t, j, start)            # ĵ_{t+1}, (B, 5k)
+            outs.append(j)
+        joints = torch.stack(outs, 1)                             # (B, longest, 5k)
+        return nn.functional.pad(joints, (0, 0, 0, S - longest))  # (B, S, 5k)
 
 
 def build_language_encoder(cfg: ModelConfig, lexicon: Lexicon = DEFAULT_LEXICON) -> LanguageEncoderBase:

@@ -35,6 +35,7 @@ from pgae_lite.data.dataset import JOINT_DIM, PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH, make_batch, signal_ids
 from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import DESCRIPTIONS
 
 #: The signals whose action target is the whole motion: their h must carry the plan.
 PLAN_SIGNALS = (EXECUTE, REPEAT_ACTION, REPEAT_BOTH)
@@ -89,7 +90,7 @@ def execute_representations(model: nn.Module, data: PGAEDataset, normaliser: Nor
     device = next(model.parameters()).device
     tensors = normaliser.tensors(data, device)
     index = torch.arange(len(data))
-    batch = make_batch(tensors, index, signal_ids("execute", len(data)), index % 8)
+    batch = make_batch(tensors, index, signal_ids("execute", len(data)), index % DESCRIPTIONS)
     return model.encode(batch)[0].cpu()
 
 

@@ -105,7 +105,7 @@ class TokenEmbedding(LanguageEncoderBase):
     def forward(self, tokens: torch.Tensor) -> torch.Tensor:
         if self.signal_shift:                                                     # signal 23 + s -> V + s
             tokens = torch.cat([tokens[:, :1] + self.signal_shift, tokens[:, 1:]], 1)
-        x = nn.functional.one_hot(tokens, self.input_dim).float()                 # (B, n+1, 28)
+        x = nn.functional.one_hot(tokens, self.input_dim).float()                 # (B, n+1, words + 5)
         x = self.norm(self.dropout(torch.relu(self.embed(x))))                    # LN(ReLU(W_L x))
         return x + positional_encoding(x.shape[1], x.shape[2]).to(x.device)       # + PE
 

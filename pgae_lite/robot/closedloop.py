@@ -39,7 +39,6 @@ Free-form instructions, executed both ways, are in :mod:`pgae_lite.robot.instruc
 """
 from __future__ import annotations
 
-import functools
 import time
 
 import numpy as np
@@ -56,21 +55,15 @@ from pgae_lite.evaluate.table1 import predict
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
 from pgae_lite.freeform.refusals import check_instruction
-from pgae_lite.sim.record import Execution, Simulation
+from pgae_lite.sim.record import Execution, Simulation, shared_simulation
 from pgae_lite.sim.robot import HOME_POSE
 from pgae_lite.viz import animate_frames
 from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_number
-from pgae_lite.world.words import WORD_INDEX, parse_description, tokenize
+from pgae_lite.world.words import DESCRIPTIONS, WORD_INDEX, parse_description, tokenize
 
 #: pybullet's default gain of a position motor (Robot.set_targets sets none): each physics
 #: step closes this share of the gap between the joint and its target.
 POSITION_GAIN = 0.1
-
-
-@functools.lru_cache(maxsize=2)
-def _simulation(config: DatasetConfig) -> Simulation:
-    """One Simulation (one physics server) per config, reused: each reset rebuilds the world."""
-    return Simulation(config.sim)
 
 
 def _drive(sim: Simulation, desired: np.ndarray, tracking: bool, render: bool) -> tuple[np.ndarray, np.ndarray | None]:
@@ -92,7 +85,7 @@ def _start(sim: Simulation, config: DatasetConfig, pattern: int, variation: int,
 def words_of(pattern: int, description: str | None = None, alternative: int = 0) -> tuple[str, ...]:
     """The three words to give the model: ``description`` (checked), else the pattern's ``alternative``-th."""
     if description is None:
-        return tuple(description_text(Pattern.from_number(pattern).descriptions()[alternative % 8]).split())
+        return tuple(description_text(Pattern.from_number(pattern).descriptions()[alternative % DESCRIPTIONS]).split())
     parse_description(description)             # a helpful LanguageError for a wrong word or order
     return tuple(tokenize(description))
 
@@ -149,7 +142,7 @@ def closed_loop(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, p
         v = normaliser.vision_to_model(extract_features(cae, frame[None]))
         return torch.from_numpy(v).to(device)
 
-    sim = _simulation(config)
+    sim = shared_simulation(config.sim, config.the_world)
     frame = _start(sim, config, pattern, variation, render=True)
     measured, frames, targets = [sim.joints()], [frame], [np.array(HOME_POSE)]
     cubes = [sim.cube_positions()]                                 # (2, 3) per step, for the book's page
@@ -183,7 +176,7 @@ def open_loop(joints: np.ndarray, pattern: int, variation: int = 0, *, descripti
     Step 0 commands the start pose, as the recordings do; then each step drives towards ``joints[t]``.
     """
     config = config or PROFILES["book"].data
-    sim = _simulation(config)
+    sim = shared_simulation(config.sim, config.the_world)
     frame = _start(sim, config, pattern, variation, render)
     measured, frames, targets = [sim.joints()], [frame], [np.array(HOME_POSE)]
     for desired in joints[1:]:
@@ -257,7 +250,7 @@ def compare(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Normaliser, data:
     joint_range = data.joint_range()
     return pd.DataFrame([
         execute_episode(model, cae, normaliser, subset, i, pred.joints[i],
-                         description_text(subset.descriptions[i, i % 8]), joint_range,
+                         description_text(subset.descriptions[i, i % DESCRIPTIONS]), joint_range,
                          config=config, tracking=tracking)
         for i in tqdm(spread(len(subset), limit), desc="open vs closed loop", unit="ep", disable=not progress)])
 

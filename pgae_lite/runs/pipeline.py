@@ -1,21 +1,12 @@
-"""From nothing to trained models: simulator -> CAE -> visual features -> any model of the book.
+"""From a profile's data to its trained models, each cached: any model of the book (paper Sec. 4).
 
-Paper, Sec. 4 (dataset) and Sec. 3 (visual features from a channel-separated
-CAE), on our simulated data. Each heavy step is cached, keyed by its config,
-so every chapter can call :func:`simulated_dataset` and get in seconds what an
-earlier chapter (or ``python -m pgae_lite simulate``) already made:
-
-1. :func:`pgae_lite.sim.dataset.generate` records the episodes of the profile's
-   world (the paper's, or one with a new colour: ``DatasetConfig.world``);
-2. :func:`trained_cae` trains the CAE on frames of the training episodes only;
-3. :func:`simulated_dataset` encodes every frame of both views into 30
-   features and returns a :class:`~pgae_lite.data.dataset.PGAEDataset`;
-4. :func:`trained_model` trains one training of :mod:`pgae_lite.runs.rows` on it
-   (a row's model of Table 1 or of the family, or a side training), cached the
-   same way, by the one training loop; :func:`trained_models` trains several
-   side by side, one per CPU core. :func:`load_model` reads a saved model back.
-
-Every function takes a :class:`~pgae_lite.config.Profile`, resolved once where the run starts.
+On the profile's simulated data (:mod:`pgae_lite.runs.data`: simulator -> CAE -> visual features,
+each step cached), :func:`trained_model` trains one training of :mod:`pgae_lite.runs.rows` (a row's
+model of Table 1 or of the family, or a side training) by the one training loop, cached under the
+digests of its data and its recipe, so every chapter gets in seconds what an earlier chapter
+already trained; :func:`trained_models` trains several side by side, one per CPU core;
+:func:`load_model` reads a saved model back. Every function takes a
+:class:`~pgae_lite.config.Profile`, resolved once where the run starts.
 """
 from __future__ import annotations
 
@@ -25,134 +16,34 @@ import warnings
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE, extract_features, load_cae, train_cae
 from pgae_lite.config import Profile, recipe_from_dict
-from pgae_lite.data.dataset import DataFormatError, PGAEDataset
+from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.freeform.phrase_lexicon import training_lexicon
 from pgae_lite.freeform.phrasing_bank import for_training
-from pgae_lite.freeform.phrasings import phrasings_digest
 from pgae_lite.model.build import build_model
+from pgae_lite.runs.data import SimulatedData, cache_stem, loaded, profile_of
 from pgae_lite.runs.rows import Training
 from pgae_lite.runs.sweep import run_sweep
-from pgae_lite.sim.dataset import DatasetConfig, episode_name, generate, to_dataset, training_frames
 from pgae_lite.util.checks import instance_of
 from pgae_lite.util.storage import (CorruptCheckpointError, FolderBusyError, cache_dir, config_digest,
-                                    default_device, load_torch, make_folder)
+                                    default_device, load_torch)
+# TEMPORARY (while the chapters and tests move to pgae_lite.runs.data): the data pipeline's names
+from pgae_lite.runs.data import cae_path, simulated_dataset, trained_cae  # noqa: F401, E402
 
 if TYPE_CHECKING:
     import torch
 
     from pgae_lite.train.loop import Trained
 
-BUSY_POLL_SECONDS = 5      # how often trained_pgae looks whether another process's training has ended
-
-
-def _stem(data: DatasetConfig, cae: CAEConfig) -> str:
-    """The cache name of the episodes of ``data`` seen through a CAE trained with ``cae``: two digests."""
-    return f"{data.key()}-{config_digest(cae.to_dict())}"
-
-
-def cae_path(data: DatasetConfig, cae: CAEConfig) -> Path:
-    """Where the CAE trained on ``data`` with ``cae`` is cached."""
-    return cache_dir() / "cae" / f"{_stem(data, cae)}.pt"
-
-
-def profile_of(profile: Profile) -> Profile:
-    """``profile`` if it is a Profile; else a one-sentence error (a name is resolved once, where a run starts)."""
-    return instance_of("profile", profile, Profile, "a Profile, resolved once where the run starts: "
-                       "pgae_lite.config.get_profile(name)")
-
-
-def trained_cae(profile: Profile, device: str | None = None, progress: bool = True,
-                workers: int | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
-    """The profile's CAE, trained on its simulated training episodes (cached) and its loss history."""
-    data, cae = profile_of(profile).data, profile.cae
-    generate(data, workers=workers, progress=progress)
-    return cached_cae(cae_path(data, cae), cae,
-                      lambda: training_frames(data, cae.frame_stride), device, progress)
-
-
-def cached_cae(path: Path, cae: CAEConfig, frames: Callable[[], np.ndarray],
-               device: str | None = None, progress: bool = True
-               ) -> tuple[ChannelSeparatedCAE, list[dict]]:
-    """The CAE cached at ``path``, else one trained with ``cae`` on ``frames()``."""
-    if path.exists():  # the path is keyed by both configs: no need to read the frames again
-        try:
-            model, ckpt = load_cae(path, device)
-            if ckpt["config"] == cae.to_dict():
-                return model, ckpt["history"]
-            raise ValueError(f"config {ckpt['config']} differs from {cae.to_dict()}")
-        except Exception as e:  # a damaged or foreign file: train again rather than use it
-            warnings.warn(f"{path}: cannot use this cached CAE ({e}); training it again", stacklevel=2)
-            path.unlink()
-    return train_cae(frames(), cae, device, progress, out_path=path)
-
-
-def simulated_dataset(profile: Profile, device: str | None = None, progress: bool = True,
-                      workers: int | None = None) -> PGAEDataset:
-    """The profile's simulated dataset with CAE features: records, trains and encodes what is not cached."""
-    prof = profile_of(profile)
-    data, cae_config = prof.data, prof.cae
-    path = cache_dir() / "features" / f"{_stem(data, cae_config)}.npz"
-
-    def make() -> PGAEDataset:
-        model, _ = trained_cae(prof, device, progress, workers)
-        return to_dataset(data, lambda frames: extract_features(model, frames),
-                          progress)
-    return cached_dataset(path, make, {"data": data.to_dict(), "cae": cae_config.to_dict()},
-                          f"simulated:{data.key()}", [f"sim/{episode_name(p, v)}" for p, v in data.episodes()])
-
-
-def made_otherwise(dataset: PGAEDataset, source: str, ids: list[str]) -> str | None:
-    """How ``dataset`` differs from the recordings ``ids`` of ``source`` it should hold, or None."""
-    if dataset.source != source:
-        return f"it holds data of {dataset.source!r}, not of {source!r}"
-    if sorted(map(str, dataset.ids)) != sorted(ids):
-        return f"it holds {len(dataset)} episodes, not the {len(ids)} recorded ones"
-    return None
-
-
-def cached_dataset(path: Path, make: Callable[[], PGAEDataset], configs: dict, source: str,
-                   ids: list[str]) -> PGAEDataset:
-    """The dataset cached at ``path``, else ``make()``'s, saved there.
-
-    A cached file is used only if its fingerprint is the digest of ``configs`` (those that make
-    the data, not the file's name), its arrays match their saved digest, and its content is what
-    the configs make: data of ``source``, the episodes ``ids``. Else it is made again.
-    """
-    fingerprint = config_digest(configs)
-    if path.exists():   # checked: the configs' fingerprint, the arrays' digest, finite, the content
-        try:
-            dataset = PGAEDataset.load(path, fingerprint=fingerprint)
-            problem = made_otherwise(dataset, source, ids)
-            if problem is None:
-                return dataset
-            warnings.warn(f"{path}: not this cache's data ({problem}); computing the features again",
-                          stacklevel=2)
-        except DataFormatError as e:
-            warnings.warn(f"{e}; computing the features again", stacklevel=2)
-    dataset = make()
-    problem = made_otherwise(dataset, source, ids)
-    if problem is not None:
-        raise DataFormatError(f"the features made for {path} are not what the configs describe: {problem}")
-    make_folder(path.parent)
-    dataset.save(path, fingerprint=fingerprint)
-    return dataset
+BUSY_POLL_SECONDS = 5      # how often trained_model looks whether another process's training has ended
 
 
 def model_folder(prof: Profile, training: str) -> Path:
     """Where the model of ``training`` with the recipe ``prof`` is cached: the data's and the recipe's digests
-    (the recipe's holds its version) and, for a training on phrasings, the sentences' own."""
-    name = f"{_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
-    phrasings = prof.train.phrasings
-    if phrasings is not None:
-        name += "-" + phrasings_digest(phrasings.per_meaning, prof.train.seed, training_lexicon(phrasings.words))
-    return cache_dir() / "pgae" / name
+    (the recipe's holds its version and, for a training on phrasings, which sentences it reads)."""
+    return cache_dir() / "pgae" / f"{cache_stem(prof.data, prof.cae)}-{training}-{config_digest(prof.to_dict())}"
 
 
 def language_source(prof: Profile):
@@ -166,7 +57,7 @@ def unit_profile(profile: Profile, training: Training, seed: int, dataset: PGAED
                  pretrained_model: str | None = None) -> Profile:
     """The recipe of one training with ``seed`` on ``dataset`` (its size: for a training whose authors counted
     iterations, under the paper profile)."""
-    base = replace(profile_of(profile), train=replace(profile.train, seed=seed))
+    base = replace(profile, train=replace(profile.train, seed=seed))
     return training.profile(base, len(dataset.split("train")), pretrained_model)
 
 
@@ -181,7 +72,7 @@ def trained_model(training: Training, profile: Profile, seed: int = 0, device: s
     from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError
 
     instance_of("training", training, Training, "a Training of pgae_lite.runs.rows (e.g. TRAININGS['PGAE'])")
-    dataset = _with_both_splits(simulated_dataset(profile, device, progress))
+    dataset = loaded(SimulatedData(profile_of(profile)), device, progress)
     prof = unit_profile(profile, training, seed, dataset)
     folder = model_folder(prof, training.name)
     while True:
@@ -244,7 +135,7 @@ def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, d
 
     prof = profile_of(profile)
     cpu = torch.device(device or default_device()).type == "cpu"
-    dataset = _with_both_splits(simulated_dataset(prof, device, progress))   # made once, before the workers read it
+    dataset = _with_both_splits(loaded(SimulatedData(prof), device, progress))   # made before the workers read it
     todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed, dataset)]
     workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     if cpu and workers > 1:
@@ -293,6 +184,5 @@ def load_model(path: str | Path, device: "torch.device | str | None" = None, dat
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["cae_path", "cached_cae", "cached_dataset", "is_trained", "language_source", "load_model",
-           "made_otherwise", "model_folder", "profile_of", "simulated_dataset", "train_when_free", "trained_cae",
-           "trained_model", "trained_models", "unit_profile"]
+__all__ = ["is_trained", "language_source", "load_model", "model_folder", "train_when_free", "trained_model",
+           "trained_models", "unit_profile"]

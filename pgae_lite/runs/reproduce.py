@@ -36,7 +36,8 @@ from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import Predictions, format_table
 from pgae_lite.runs.rows import ROWS, TABLE1_ROWS
 from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
-from pgae_lite.runs.table1_unit import check_made_on, remember_dataset, table1_unit
+from pgae_lite.runs.data import data_source, loaded, remember
+from pgae_lite.runs.table1_unit import check_made_on, table1_unit
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.util.storage import atomic_write, atomic_write_text, default_device, make_folder
@@ -185,7 +186,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
         done = run_sweep(table1_unit, units, workers=min(workers or os.cpu_count() or 1, len(units)),
                          scheduler=scheduler, logs=Path(out) / "logs", name="table1", progress=progress)
     else:
-        remember_dataset(source, profile, dataset)
+        remember(data_source(original_data, profile), dataset)
         done = [table1_unit(*unit, progress=progress) for unit in units]
     report = {"data": dataset.source, "profile": profile.name, "seeds": seeds, "rows": {}, "trainings": {}}
     for row in rows:
@@ -234,17 +235,12 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     cores (default: all), or on the Dask cluster at ``scheduler`` (:func:`run_table1`). Every
     argument is checked before any data is read (:func:`check_arguments`).
     """
-    from pgae_lite.data.original import load_original
-
     rows = check_arguments(original_data, rows, seed, seeds, epochs, device,
                            pretrained_model, out_dir, workers, scheduler)
     prof = get_profile(profile, **({} if epochs is None else {"epochs": epochs}))
-    if original_data is not None:
-        dataset, source = load_original(original_data), "original"
-    else:
-        from pgae_lite.runs.pipeline import simulated_dataset
-        dataset, source = simulated_dataset(prof, device, progress), "simulated"
-    default_out = f"runs/{source}-{prof.name}-seed{seed}"
+    source = data_source(original_data, prof)        # the authors' folder, or this profile's simulated data
+    dataset = loaded(source, device, progress)
+    default_out = f"runs/{source.kind}-{prof.name}-seed{seed}"
     out = Path(out_dir if out_dir is not None else default_out)
     t0 = time.perf_counter()
     report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,

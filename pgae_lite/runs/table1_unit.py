@@ -6,9 +6,9 @@ recipe and data loads it) and measured by the one evaluation, N.A. where it has 
 
 Paper, Sec. 4 and Table 1. ``reproduce`` over seeds is a list of these units, run one after
 another in this process or as tasks on a Dask cluster (:mod:`pgae_lite.runs.sweep`). A unit
-runs wherever its worker is, so it finds its data there (:func:`worker_dataset`): the
-authors' folder at the same path (a shared disk, or a copy at that path), or this profile's
-simulated data from the worker's own cache, recorded and encoded there if missing. It
+runs wherever its worker is, so it finds its data there (:func:`~pgae_lite.runs.data.loaded`: the authors'
+folder at the same path, a shared disk or a copy at that path; or this profile's simulated data from the
+worker's own cache, recorded and encoded there if missing). It
 returns everything the report needs (cells, predictions, training time) and the data
 statistics its model was trained on, which the sweep's caller checks against its own data
 (:func:`check_made_on`): a worker whose CAE gave other features fails the sweep with a
@@ -23,38 +23,15 @@ from pgae_lite.config import Profile
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import evaluate
-from pgae_lite.runs.pipeline import simulated_dataset, train_when_free, unit_profile
+from pgae_lite.runs.data import data_source, loaded
+from pgae_lite.runs.pipeline import train_when_free, unit_profile
+# TEMPORARY (while the benchmarks move to pgae_lite.runs.data)
+from pgae_lite.runs.data import worker_dataset  # noqa: F401, E402
 from pgae_lite.runs.rows import Row, Training
 from pgae_lite.train.checkpoint import check_trained_on, training_split
-from pgae_lite.util.storage import cache_dir, config_digest
+from pgae_lite.util.storage import cache_dir
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
-_LOADED: dict[tuple, PGAEDataset] = {}              # this process's data, loaded once per source
-
-
-def _data_key(original_data: str | None, profile: Profile) -> tuple:
-    return (original_data,) if original_data else ("simulated", config_digest(profile.data.to_dict()),
-                                                   config_digest(profile.cae.to_dict()))
-
-
-def worker_dataset(original_data: str | None, profile: Profile, device: str | None = None) -> PGAEDataset:
-    """The data a unit trains and measures on, loaded once per process: the authors' folder
-    ``original_data``, else ``profile``'s simulated data from this machine's cache (made if missing)."""
-    key = _data_key(original_data, profile)
-    if key not in _LOADED:
-        if original_data:
-            from pgae_lite.data.original import load_original
-            _LOADED[key] = load_original(original_data)
-        else:
-            _LOADED[key] = simulated_dataset(profile, device, progress=False)
-    return _LOADED[key]
-
-
-def remember_dataset(original_data: str | None, profile: Profile, dataset: PGAEDataset) -> None:
-    """Units run in this process use ``dataset`` (already loaded by the caller) for that source."""
-    _LOADED[_data_key(original_data, profile)] = dataset
-
-
 def table1_unit(original_data: str | None, profile: Profile, training: Training, seed: int, rows: list[Row],
                 out: str, device: str | None = None, pretrained_model: str | None = None,
                 progress: bool = False) -> dict:
@@ -64,7 +41,7 @@ def table1_unit(original_data: str | None, profile: Profile, training: Training,
     Predictions}}, "profile": the recipe, "normaliser": the statistics it was trained on, "made_on": host
     and cache}``.
     """
-    dataset = worker_dataset(original_data, profile, device)
+    dataset = loaded(data_source(original_data, profile), device)
     prof = unit_profile(profile, training, seed, dataset, pretrained_model)
     trained = train_when_free(dataset, prof, Path(out) / f"{training.name}-seed{seed}", device, progress,
                               training.name)
@@ -92,4 +69,4 @@ def check_made_on(result: dict, dataset: PGAEDataset, folder: Path) -> None:
                      f"{dataset.source}; the model was trained on {result['made_on']}")
 
 
-__all__ = ["SHARED_WITH_SELF", "check_made_on", "remember_dataset", "table1_unit", "worker_dataset"]
+__all__ = ["SHARED_WITH_SELF", "check_made_on", "table1_unit"]

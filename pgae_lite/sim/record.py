@@ -271,8 +271,9 @@ class Simulation:
 
 
 @functools.lru_cache(maxsize=4)
-def _simulation(config: SimConfig, world: World = DEFAULT_WORLD) -> Simulation:
-    """One Simulation (one physics server) per config, world and process, reused."""
+def shared_simulation(config: SimConfig, world: World = DEFAULT_WORLD) -> Simulation:
+    """One Simulation (one physics server) per config, world and process, reused by every caller (a recording's
+    replay here, the closed loop of :mod:`pgae_lite.robot.closedloop`): each reset rebuilds the world."""
     return Simulation(config, world)
 
 
@@ -286,7 +287,7 @@ def execute_trajectory(joints: np.ndarray, pattern: int, variation: int = 0, con
     result holds the frames, the measured joints, the cube displacement and
     whether the pattern's action succeeded, by the same check as the recordings.
     """
-    sim = _simulation(config, world)
+    sim = shared_simulation(config, world)
     sim.reset(pattern, variation, base_seed, agent, render=False)
     return sim.run(joints, render)
 
@@ -298,7 +299,7 @@ def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig()
     ``world``: patterns beyond 143, their colours (:func:`pgae_lite.world.colours.with_colour`).
     """
     pat = _validate(pattern, variation, base_seed, world)
-    sim = _simulation(config, world)
+    sim = shared_simulation(config, world)
     failures = []
     for attempt in range(config.max_attempts):
         seed = episode_seed(pattern, variation, base_seed, attempt)
@@ -330,4 +331,4 @@ def record_episode(pattern: int, variation: int, config: SimConfig = SimConfig()
 
 
 __all__ = ["SimConfig", "Episode", "Execution", "Simulation", "record_episode", "execute_trajectory",
-           "episode_seed", "scene_layout", "AGENTS"]
+           "shared_simulation", "episode_seed", "scene_layout", "AGENTS"]

@@ -19,6 +19,7 @@ import torch
 
 from pgae_lite.data.dataset import JOINT_DIM
 from pgae_lite.train.supervision import draw_signals
+from pgae_lite.world.words import DESCRIPTIONS
 
 
 def add_input_noise(action_input: torch.Tensor, std: float, joint_std: float | None = None) -> torch.Tensor:
@@ -46,7 +47,7 @@ class Draws:
 
     def descriptions(self, size: int) -> torch.Tensor:
         """Which of the 8 equivalent descriptions each of ``size`` samples reads (size,)."""
-        return torch.randint(8, (size,), generator=self.generator)
+        return torch.randint(DESCRIPTIONS, (size,), generator=self.generator)
 
     def views(self, size: int) -> torch.Tensor:
         """Whether each of ``size`` samples shows the opposite agent's view (size,) bool."""

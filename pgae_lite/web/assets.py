@@ -36,7 +36,8 @@ from pgae_lite.config import Profile
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
-from pgae_lite.runs.pipeline import profile_of, simulated_dataset, trained_cae, trained_model
+from pgae_lite.runs.data import SimulatedData, loaded, profile_of
+from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import TRAININGS
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
@@ -108,7 +109,8 @@ def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool 
     prof = profile_of(profile)
     out = make_folder(out)
     make_folder(out / "models")
-    data = simulated_dataset(prof, "cpu", progress=progress)
+    source = SimulatedData(prof)
+    data = loaded(source, "cpu", progress)
     trained = {name: trained_model(training, prof, seed, device="cpu", progress=progress)
                for name, training in MODELS.items()}
     models, encoders, normaliser = {}, {}, None
@@ -149,9 +151,7 @@ def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool 
         "sim_runs": "sim_runs.json" if simulate else None, "frames": frames,
     }
     if simulate:
-        cae, _ = trained_cae(prof, "cpu", progress=progress)          # NICO's eye: frame -> 30 features
-        simulator_runs(out, trained, data.split("test"), cae, prof.data, {"profile": prof.name, "seed": seed},
-                       progress=progress)
+        simulator_runs(out, trained, source, {"profile": prof.name, "seed": seed}, progress=progress)
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
 

@@ -52,7 +52,8 @@ class EpisodeGraph(nn.Module):
 
     def forward(self, language: torch.Tensor, action_input: torch.Tensor, dec_vision: torch.Tensor,
                 start: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
-        f_lang = self.language_encoder(language, None) if self.reads_tokens else language   # (1, 400) or (1, D)
+        # (1, 2 · layers · units) from tokens, or (1, D) features given
+        f_lang = self.language_encoder(language, None) if self.reads_tokens else language
         k = self.action_encoder.stride
         _, state = self.action_encoder.rnn(action_input[:, ::k], None)       # every k-th step, all of them
         h, z = self.gmu(state_to_vector(state), f_lang)                       # h = z ⊙ A_h + (1 − z) ⊙ L_h

@@ -25,10 +25,9 @@ from pathlib import Path
 import numpy as np
 from tqdm.auto import tqdm
 
-from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.data.dataset import PGAEDataset, description_text
 from pgae_lite.robot.closedloop import closed_loop, variation_of
-from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.runs.data import SimulatedData, loaded, trained_cae
 from pgae_lite.util.storage import atomic_write_text, make_folder
 
 LABEL = ("Run in the pybullet simulator when this book was built, closed loop: "
@@ -52,13 +51,15 @@ def _values(array: np.ndarray) -> list:
     return np.round(np.asarray(array, dtype=np.float64), DECIMALS).tolist()
 
 
-def simulator_runs(out: str | Path, trained: dict, test: PGAEDataset, cae: ChannelSeparatedCAE,
-                   config: DatasetConfig, label: dict, progress: bool = False) -> dict:
-    """Run every model of ``trained`` (the page's name -> its trained model,
-    :func:`~pgae_lite.web.assets.export_web`'s) closed loop on :func:`chosen_episodes` of ``test``, with NICO's
-    eye ``cae`` in the scenes ``config`` records; write ``out/sim_runs.json`` (see the module docstring, with
-    ``label``'s profile and seed) and return its content."""
+def simulator_runs(out: str | Path, trained: dict, source: SimulatedData, label: dict, progress: bool = False) -> dict:
+    """Run every model of ``trained`` (the page's name -> its trained model, :func:`~pgae_lite.web.assets.export_web`'s)
+    closed loop on :func:`chosen_episodes` of ``source``'s test split, with NICO's eye, its CAE, in the scenes its
+    profile records; write ``out/sim_runs.json`` (see the module docstring, with ``label``'s profile and seed)
+    and return its content. The CAE and the data come from the cache (made there when missing)."""
     out = make_folder(out)
+    test = loaded(source, "cpu", progress).split("test")
+    cae, _ = trained_cae(source.profile, "cpu", progress=progress)        # NICO's eye: frame -> 30 features
+    config = source.profile.data
     rows = chosen_episodes(test)
     runs = []
     for name, run_of in trained.items():

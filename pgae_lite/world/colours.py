@@ -117,11 +117,6 @@ class World:
         """The patterns beyond the paper's 144."""
         return tuple(range(PAPER_PATTERNS, self.n_patterns))
 
-    def patterns_with(self, colour: str) -> tuple[int, ...]:
-        """The added patterns whose arrangement has a cube of ``colour``."""
-        cubes = {n: self.pattern(n) for n in self.new_patterns}
-        return tuple(n for n, p in cubes.items() if colour in (p.left, p.right))
-
     def pattern_number(self, speed: int, arrangement: int, action: int) -> int:
         """The paper's numbering to arrangement 11, then :data:`EXTENSION_NUMBERING`."""
         for name, value, count in (("speed", speed, 2), ("arrangement", arrangement, len(self.arrangements)),

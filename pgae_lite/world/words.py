@@ -59,6 +59,8 @@ SPEEDS: tuple[str, ...] = ("slowly", "fast")
 #: The grammar: which canonical words may stand at each of the three positions.
 SLOTS: tuple[tuple[str, ...], ...] = (ACTIONS, COLOURS, SPEEDS)
 SLOT_NAMES: tuple[str, ...] = ("action", "colour", "speed")
+#: Equivalent descriptions of one meaning: each of its three words or its synonym, 2 x 2 x 2.
+DESCRIPTIONS = 2 ** len(SLOTS)
 
 CANONICAL: dict[str, str] = {**{w: w for w in SYNONYMS}, **{s: w for w, s in SYNONYMS.items()}}
 
@@ -312,7 +314,7 @@ def _word_indices(indices, n: int) -> torch.Tensor:
     except (TypeError, ValueError, RuntimeError, OverflowError):
         raise LanguageError(f"{wanted}; got {indices!r:.80}") from None
     if t.dim() == 2 and t.shape[1] == n and t.dtype != torch.bool and not t.is_complex():
-        return _chosen(t, wanted)       # (steps, 23) one-hot or probabilities
+        return _chosen(t, wanted)       # (steps, words) one-hot or probabilities
     if t.dim() != 1 or t.dtype == torch.bool or t.is_complex():
         raise LanguageError(f"{wanted}; got {t.dim()}-D {t.dtype} of shape "
                             f"{tuple(t.shape)}")
