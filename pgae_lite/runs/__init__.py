@@ -1,7 +1,8 @@
 """Runs: the cached pipeline, the rows' registry, Table 1 over seeds, the sweep, the result files.
 
 - ``rows``        the book's trainings and Table 1's and the family's rows: how each is built, trained, measured
-- ``pipeline``    simulator -> CAE -> features -> any trained model, each step cached; ``load_model``
+- ``data``        simulator -> CAE -> features, each step cached; where a run's data comes from, loaded once
+- ``pipeline``    any trained model of the book on that data, cached; ``load_model``
 - ``table1_unit`` one training of one seed, measured on its rows: a unit of reproduce's sweep
 - ``reproduce``   every row of Table 1 (and the family's) over seeds (``python -m pgae_lite reproduce``)
 - ``sweep``       many trainings as tasks on a Dask cluster, from a laptop to a lab's cluster
