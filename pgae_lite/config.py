@@ -12,31 +12,22 @@ line, a chapter, a benchmark): :func:`get_profile`. Below that, functions take `
 values, and no behaviour depends on a profile's name. The environment variable
 ``PGAE_LITE_PROFILE`` picks the default profile; :func:`profile_name` is the only code that reads it.
 The trainings of Table 1's rows and of the family's are values too, beside the code that runs
-them (:mod:`pgae_lite.runs.rows`). :func:`recipe_from_dict` reads a recipe a checkpoint saved.
+them (:mod:`pgae_lite.runs.rows`).
 """
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field, fields, replace
 
-from pgae_lite.bert.config import PretrainedConfig
 from pgae_lite.cae import CAEConfig
-from pgae_lite.freeform.attention_pooling import AttentionConfig
-from pgae_lite.freeform.phrasing_bank import PhrasingsConfig
-from pgae_lite.model.config import PARTS, ModelConfig
-from pgae_lite.model.prae import BindingConfig
-from pgae_lite.model.ptae import CrossmodalConfig
+from pgae_lite.model.config import ModelConfig
 from pgae_lite.sim.dataset import DatasetConfig
-from pgae_lite.train.config import RECIPE_VERSION, TRAIN_PARTS, TrainConfig
-from pgae_lite.train.supervision import SupervisionConfig
+from pgae_lite.train.config import RECIPE_VERSION, TrainConfig
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.patterns import pattern_number
 
 PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")   # the keys of PROFILES
-#: Every part a recipe may hold, by the kind its dict names (recipe_from_dict).
-PART_KINDS = {c.kind: c for c in (PretrainedConfig, AttentionConfig, CrossmodalConfig, BindingConfig,
-                                  SupervisionConfig, PhrasingsConfig)}
 
 
 @dataclass(frozen=True)
@@ -168,22 +159,3 @@ def with_world(profile: Profile, world) -> Profile:
     data records the world's patterns (the paper's recordings, then the world's own) and its model reads and
     writes the world's words. The one pipeline does the rest (:mod:`pgae_lite.runs.pipeline`)."""
     return replace(profile, data=replace(profile.data, world=world))
-
-
-def _with_parts(settings: dict, parts: tuple[str, ...], where: str) -> dict:
-    """A saved config's dict with each part's dict made its part again (by its kind)."""
-    out = dict(settings)
-    for name in parts:
-        if out.get(name) is not None:
-            kind = out[name].get("kind")
-            if kind not in PART_KINDS:
-                raise ValueError(f"{where}: unknown part {name}={kind!r}; the parts are: {', '.join(PART_KINDS)}")
-            settings = {f.name for f in fields(PART_KINDS[kind])}       # not what its dict adds (kind, digests)
-            out[name] = PART_KINDS[kind](**{k: v for k, v in out[name].items() if k in settings})
-    return out
-
-
-def recipe_from_dict(recipe: dict) -> tuple[ModelConfig, TrainConfig]:
-    """The model's and the training's settings of a recipe saved as :meth:`Profile.to_dict` wrote it."""
-    model = ModelConfig(**_with_parts(recipe["model"], PARTS, "the model's settings"))
-    return model, TrainConfig(**_with_parts(recipe["train"], TRAIN_PARTS, "the training's settings"))

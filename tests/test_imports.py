@@ -113,7 +113,7 @@ LAYERS = {
     "evaluate": {"model", "data", "world", "util"},
     "viz": {"model", "data", "world", "util"},
     "train": {"model", "data", "world", "util"},
-    "config": {"freeform", "bert", "train", "model", "cae", "sim", "world", "util"},
+    "config": {"train", "model", "cae", "sim", "world", "util"},
     "exercises": {"train", "evaluate", "model", "data", "sim", "world", "util"},
     "runs": {"config", "freeform", "bert", "train", "evaluate", "model", "cae", "data", "sim", "world", "util"},
     "robot": {"runs", "config", "freeform", "evaluate", "bert", "model", "cae", "data", "sim", "viz", "world",

@@ -13,19 +13,26 @@ from __future__ import annotations
 import os
 import time
 import warnings
-from dataclasses import replace
+from dataclasses import fields, replace
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from pgae_lite.config import Profile, recipe_from_dict
+from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.config import Profile
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.freeform.phrasing_bank import for_training
+from pgae_lite.freeform.attention_pooling import AttentionConfig
+from pgae_lite.freeform.phrasing_bank import PhrasingsConfig, for_training
 from pgae_lite.model.build import build_model
+from pgae_lite.model.config import PARTS, ModelConfig
+from pgae_lite.model.prae import BindingConfig
+from pgae_lite.model.ptae import CrossmodalConfig
 from pgae_lite.runs.data import SimulatedData, cache_stem, loaded, profile_of
 from pgae_lite.runs.rows import Training
 from pgae_lite.runs.sweep import run_sweep
+from pgae_lite.train.config import TRAIN_PARTS, TrainConfig
+from pgae_lite.train.supervision import SupervisionConfig
 from pgae_lite.util.checks import instance_of
 from pgae_lite.util.storage import (CorruptCheckpointError, FolderBusyError, cache_dir, config_digest,
                                     default_device, load_torch)
@@ -37,6 +44,9 @@ if TYPE_CHECKING:
 
     from pgae_lite.train.loop import Trained
 
+#: Every part a recipe may hold, by the kind its dict names (recipe_from_dict).
+PART_KINDS = {c.kind: c for c in (PretrainedConfig, AttentionConfig, CrossmodalConfig, BindingConfig,
+                                  SupervisionConfig, PhrasingsConfig)}
 BUSY_POLL_SECONDS = 5      # how often trained_model looks whether another process's training has ended
 
 
@@ -161,6 +171,26 @@ def is_trained(training: Training, profile: Profile, seed: int, dataset: PGAEDat
         return False
 
 
+def _with_parts(settings: dict, parts: tuple[str, ...], where: str) -> dict:
+    """A saved config's dict with each part's dict made its part again (by its kind)."""
+    out = dict(settings)
+    for name in parts:
+        if out.get(name) is not None:
+            kind = out[name].get("kind")
+            if kind not in PART_KINDS:
+                raise ValueError(f"{where}: unknown part {name}={kind!r}; the parts are: {', '.join(PART_KINDS)}")
+            settings = {f.name for f in fields(PART_KINDS[kind])}       # not what its dict adds (kind, digests)
+            out[name] = PART_KINDS[kind](**{k: v for k, v in out[name].items() if k in settings})
+    return out
+
+
+def recipe_from_dict(recipe: dict) -> tuple[ModelConfig, TrainConfig]:
+    """The model's and the training's settings of a recipe saved as :meth:`~pgae_lite.config.Profile.to_dict`
+    wrote it (a checkpoint's)."""
+    model = ModelConfig(**_with_parts(recipe["model"], PARTS, "the model's settings"))
+    return model, TrainConfig(**_with_parts(recipe["train"], TRAIN_PARTS, "the training's settings"))
+
+
 def load_model(path: str | Path, device: "torch.device | str | None" = None, dataset: PGAEDataset | None = None,
                lexicon=None) -> tuple["torch.nn.Module", Normaliser, dict]:
     """Model (in eval mode), normaliser and the checkpoint's other contents, from a checkpoint any training of
@@ -184,5 +214,5 @@ def load_model(path: str | Path, device: "torch.device | str | None" = None, dat
     return model, Normaliser.from_state_dict(ckpt["normaliser"]), ckpt
 
 
-__all__ = ["is_trained", "language_source", "load_model", "model_folder", "train_when_free", "trained_model",
-           "trained_models", "unit_profile"]
+__all__ = ["PART_KINDS", "is_trained", "language_source", "load_model", "model_folder", "recipe_from_dict",
+           "train_when_free", "trained_model", "trained_models", "unit_profile"]
