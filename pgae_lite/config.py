@@ -156,6 +156,10 @@ def get_profile(name: Profile | str | None = None, **train_overrides) -> Profile
 
 def with_world(profile: Profile, world) -> Profile:
     """``profile`` in a world beyond the paper's (:func:`pgae_lite.world.colours.with_colour`, appendix A3): its
-    data records the world's patterns (the paper's recordings, then the world's own) and its model reads and
-    writes the world's words. The one pipeline does the rest (:mod:`pgae_lite.runs.pipeline`)."""
-    return replace(profile, data=replace(profile.data, world=world))
+    data records the world's patterns (the paper's recordings, then the world's own: those the profile records
+    of the paper's, and every new one) and its model reads and writes the world's words. The one pipeline does
+    the rest (:mod:`pgae_lite.runs.pipeline`)."""
+    patterns = profile.data.patterns
+    if patterns is not None:                   # a profile of some of the paper's patterns (smoke): all the new ones
+        patterns = tuple(patterns) + tuple(p for p in world.new_patterns if p not in patterns)
+    return replace(profile, data=replace(profile.data, world=world, patterns=patterns))

@@ -131,7 +131,7 @@ def check_new_colour(model, normaliser: Normaliser, dataset: PGAEDataset, colour
     if not held.any():
         return result.fail(f"the dataset has no held-out episodes with a {colour} cube",
                            "record the new patterns and build the data with "
-                           "pgae_lite.runs.pipeline.simulated_dataset(with_world(profile, world))")
+                           "pgae_lite.runs.data.simulated_dataset(with_world(profile, world))")
     if int(dataset.descriptions.max()) >= lexicon.size:
         return result.fail(f"the dataset has word indices up to "
                            f"{int(dataset.descriptions.max())}, beyond the model's "

@@ -6,7 +6,7 @@ bottleneck and plan head. What only some models read lives in a part beside thei
 the plain recipe (PGAE):
 
     language    a pretrained language encoder in place of the LSTM over one-hot words:
-                PGAE-BERT's (:class:`pgae_lite.bert.pretrained.PretrainedConfig`) or the free-form
+                PGAE-BERT's (:class:`pgae_lite.bert.config.PretrainedConfig`) or the free-form
                 variant's (:class:`pgae_lite.freeform.attention_pooling.AttentionConfig`)
     crossmodal  PTAE's crossmodal transformer in place of the GMU (:class:`pgae_lite.model.ptae.CrossmodalConfig`)
     binding     PRAE's and PVAE's two autoencoders bound by a loss (:class:`pgae_lite.model.prae.BindingConfig`)
@@ -97,7 +97,7 @@ class ModelConfig:
             part = getattr(self, name)
             if part is not None and not isinstance(part, Part):
                 raise ValueError(f"ModelConfig {name} must be None or a part's settings (e.g. "
-                                 f"pgae_lite.bert.pretrained.PretrainedConfig()); got {part!r}")
+                                 f"pgae_lite.bert.config.PretrainedConfig()); got {part!r}")
             if part is not None:
                 part.check(self)
         if self.crossmodal is not None and self.binding is not None:

@@ -42,7 +42,7 @@ class LanguageEncoderBase(nn.Module):
         """Free text: not for this encoder, which reads one-hot tokens of the dataset's words."""
         raise LanguageError(f"{type(self).__name__} reads only the dataset's words, as tokens "
                             "(pgae_lite.model.signals.make_batch); free text needs a pretrained encoder "
-                            "(ModelConfig language=pgae_lite.bert.pretrained.PretrainedConfig())")
+                            "(ModelConfig language=pgae_lite.bert.config.PretrainedConfig())")
 
     def export_head(self) -> nn.Module | None:
         """The page's head on the transformer's token vectors (see the module): None, no transformer here."""

@@ -19,7 +19,7 @@ missing. A file whose digest does not match the manifest (or, if it is not in
 the manifest yet, whose contents fail their own check, or hold another
 episode than its name says) is reported and recorded again, never used.
 
-:func:`~pgae_lite.runs.pipeline.simulated_dataset` turns the episodes into the same
+:func:`~pgae_lite.runs.data.simulated_dataset` turns the episodes into the same
 :class:`~pgae_lite.data.dataset.PGAEDataset` as the authors' loader produces, with
 visual features from a trained channel-separated CAE (also cached).
 """
