@@ -6,7 +6,7 @@
 Each ablation changes one thing of the profile's recipe (``book``), exactly as its
 exercise's solution does, and trains PGAE on our simulated data (the
 chapter's data) once per seed; the recipe itself (``recipe``, the cached
-:func:`pgae_lite.runs.pipeline.trained_pgae`) is the baseline, on the same seeds.
+:func:`pgae_lite.runs.pipeline.trained_model`) is the baseline, on the same seeds.
 Writes every model's Table 1 cells and training time to
 results/ablations.json, so a solution can say whether its effect exceeds the
 spread of the seeds. With ``--workers N`` N models train side by side, each in
@@ -17,17 +17,18 @@ shorter budget shows what a change does to the speed of learning.
 from __future__ import annotations
 
 import copy
-import functools
 from dataclasses import replace
 
 import torch
 
 from harness import Benchmark, side_by_side
 from pgae_lite.world import words as language
-from pgae_lite.config import get_profile
+from pgae_lite.config import Profile, get_profile
 from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.runs.pipeline import trained_model
+from pgae_lite.runs.rows import TRAININGS
+from pgae_lite.runs.table1_unit import worker_dataset
 from pgae_lite.model.layers import ConcatBottleneck
 from pgae_lite.train.loop import train
 
@@ -71,9 +72,9 @@ def budget(epochs: int | None) -> dict:
     return {"epochs": epochs} if epochs else {}
 
 
-def train_ablation(name: str, data, profile_name: str, seed: int, epochs: int | None = None):
+def train_ablation(name: str, data, profile: Profile, seed: int, epochs: int | None = None):
     change, build = ABLATIONS[name]
-    profile = get_profile(profile_name, seed=seed, **budget(epochs))
+    profile = get_profile(profile, seed=seed, **budget(epochs))
     if callable(change):
         profile = change(profile)
     if build:           # its initial weights the same for the same seed, whatever this process ran before
@@ -88,17 +89,19 @@ def train_ablation(name: str, data, profile_name: str, seed: int, epochs: int | 
         language.WORD_WEIGHTS.update(saved)
 
 
-#: the simulated data, loaded once per process (every job in a worker reads the same)
-dataset = functools.cache(simulated_dataset)
+def dataset(profile: Profile):
+    """The simulated data, loaded once per process (every job in a worker reads the same)."""
+    return worker_dataset(None, profile, "cpu")
 
 
-def measure(name: str, seed: int, profile_name: str, threads: int | None, epochs: int | None = None) -> dict:
+def measure(name: str, seed: int, profile: Profile, threads: int | None, epochs: int | None = None) -> dict:
     """One model (the recipe's or one ablation's) trained on our data and its Table 1 cells."""
     if threads:
         torch.set_num_threads(threads)
-    data = dataset(profile_name, "cpu", progress=False)
-    trained = (trained_pgae("PGAE", profile_name, seed, device="cpu", progress=False, **budget(epochs))
-               if name == "recipe" else train_ablation(name, data, profile_name, seed, epochs))
+    data = dataset(profile)
+    trained = (trained_model(TRAININGS["PGAE"], get_profile(profile, **budget(epochs)), seed, device="cpu",
+                             progress=False)
+               if name == "recipe" else train_ablation(name, data, profile, seed, epochs))
     cells, _ = evaluate(trained.model, data, trained.normaliser)
     print(name, seed, {s: (round(c["accuracy"], 2), round(c["nrmse"], 3)) for s, c in cells.items()},
           flush=True)
@@ -113,11 +116,12 @@ def main() -> None:
     bench.parser.add_argument("--epochs", type=int, default=None,
                               help="train the recipe and every change for this many epochs (default: the profile's)")
     args = bench.parse()
-    dataset(args.profile, "cpu", progress=False)                # recorded once, before the workers start
+    profile = get_profile(args.profile)                         # resolved once, here
+    dataset(profile)                                            # recorded once, before the workers start
     threads = 1 if args.workers > 1 else args.threads
-    jobs = [(name, seed, args.profile, threads, args.epochs) for name in ["recipe", *args.ablations]
+    jobs = [(name, seed, profile, threads, args.epochs) for name in ["recipe", *args.ablations]
             for seed in args.seeds]
-    bench.write({"data": "ours (simulated)", "epochs": args.epochs or get_profile(args.profile).train.epochs,
+    bench.write({"data": "ours (simulated)", "epochs": args.epochs or profile.train.epochs,
                  "runs": side_by_side(measure, jobs, args.workers)})
 
 

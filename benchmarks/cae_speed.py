@@ -33,7 +33,7 @@ from pgae_lite.cae import (
     reconstruct,
     train_cae,
 )
-from pgae_lite.config import get_profile
+from pgae_lite.config import Profile, get_profile
 from pgae_lite.util.storage import default_device
 
 COLOURS = [(200, 35, 30), (40, 170, 50), (35, 60, 205), (225, 210, 40), (40, 200, 215), (150, 45, 190)]
@@ -113,9 +113,9 @@ def time_extraction(model, x, seconds) -> float:
     return (time.perf_counter() - t0) / n
 
 
-def trained_row(args, seed: int, device: torch.device) -> dict:
+def trained_row(args, profile: Profile, seed: int, device: torch.device) -> dict:
     """Train the profile's CAE (seeded ``seed``) on ``--frames`` frames; its time and reconstruction quality."""
-    config = replace(get_profile(args.profile).cae, seed=seed,
+    config = replace(profile.cae, seed=seed,
                      **({"iterations": args.iterations} if args.iterations else {}))
     data = frames(args.frames, args.episodes, args.stride, seed=0)
     test = frames(args.frames, max(2, args.episodes // 8), 4, seed=1)
@@ -168,9 +168,10 @@ def main() -> None:
         bench.name = "cae_speed-train"         # results/cae_speed-train.json
     device = default_device()
     load = os.getloadavg()[0]                  # > 0.5 before we start: another job shares the cores
+    profile = get_profile(args.profile)        # resolved once, here
     rows = []
     for seed in args.seeds:
-        rows.append(trained_row(args, seed, device) if args.train else speed_row(args, seed, device))
+        rows.append(trained_row(args, profile, seed, device) if args.train else speed_row(args, seed, device))
         print(rows[-1], flush=True)
     bench.write({"mode": "train" if args.train else "steps", "device": str(device), "load_average": load,
                  **({"data": args.frames, "episodes": args.episodes, "stride": args.stride} if args.train

@@ -5,7 +5,7 @@
                                      [--set plan_weight=1 epochs=200]
 
 For each training and seed, the profile's recipe model on our simulated data
-(:func:`pgae_lite.runs.pipeline.trained_pgae`: trained once, then cached) executes
+(:func:`pgae_lite.runs.pipeline.trained_model`: trained once, then cached) executes
 each test episode twice (:func:`pgae_lite.robot.closedloop.compare`): open loop, the
 paper's execute (the decoder reads the recorded vision), and closed loop (it
 reads what its own motion shows). Prints the success rate per action and
@@ -22,7 +22,6 @@ the profile's, for every training; the models are cached under their own names.
 """
 from __future__ import annotations
 
-import functools
 import statistics
 import time
 
@@ -30,30 +29,35 @@ import torch
 
 from harness import Benchmark, key_value, side_by_side
 from pgae_lite.robot.closedloop import compare, success_summary
-from pgae_lite.config import get_profile
-from pgae_lite.runs.trainings import by_name
+from pgae_lite.config import Profile, get_profile
+from pgae_lite.runs.rows import training_named
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.evaluate.table1 import evaluate
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model
 from pgae_lite.model.plan import which_cube_probe
 
+_LOADED: dict = {}      # (data, CAE settings) -> (CAE, dataset), in this process
 
-@functools.cache
-def cae_and_data(profile: str):
+
+def cae_and_data(profile: Profile):
     """The profile's CAE and simulated data, loaded once per process (every job in a worker reads the same)."""
-    return trained_cae(profile, "cpu", progress=False)[0], simulated_dataset(profile, "cpu", progress=False)
+    key = (profile.data, profile.cae)
+    if key not in _LOADED:
+        _LOADED[key] = trained_cae(profile, "cpu", progress=False)[0], simulated_dataset(profile, "cpu", progress=False)
+    return _LOADED[key]
 
 
-def measure(training: str, seed: int, profile: str, threads: int | None, limit: int | None,
+def measure(training: str, seed: int, profile: Profile, threads: int | None, limit: int | None,
             tracking: bool, overrides: dict) -> dict:
     """One model (trained once, then cached) in open and closed loop, with its Table 1 cells."""
     if threads:
         torch.set_num_threads(threads)
     cae, data = cae_and_data(profile)
-    trained = trained_pgae(by_name(training), profile, seed, device="cpu", progress=False, **overrides)
+    trained = trained_model(training_named(training), get_profile(profile, **overrides), seed, device="cpu",
+                            progress=False)
     t0 = time.perf_counter()
     table = compare(trained.model, cae, trained.normaliser, data, limit=limit,
-                    config=get_profile(profile).data, tracking=tracking)
+                    config=profile.data, tracking=tracking)
     seconds = time.perf_counter() - t0
     summary = success_summary(table)
     open_, closed = 100 * table["open_passed"].mean(), 100 * table["closed_passed"].mean()
@@ -84,13 +88,16 @@ def main() -> None:
     bench.add_workers(1, "trainings")
     args = bench.parse()
     overrides = dict(args.set)
+    profile = get_profile(args.profile)                        # resolved once, here
     try:
-        get_profile(args.profile, **overrides)                 # an unknown option fails here, at once
+        get_profile(profile, **overrides)                      # an unknown option fails here, at once
+        for training in args.trainings:
+            training_named(training)                           # so does an unknown training
     except ArgumentError as e:
         bench.parser.error(str(e))
-    cae_and_data(args.profile)                                 # data and CAE made once, before the workers
+    cae_and_data(profile)                                      # data and CAE made once, before the workers
     threads = 1 if args.workers > 1 else args.threads
-    jobs = [(training, seed, args.profile, threads, args.limit, not args.no_tracking, overrides)
+    jobs = [(training, seed, profile, threads, args.limit, not args.no_tracking, overrides)
             for training in args.trainings for seed in args.seeds]
     runs = side_by_side(measure, jobs, args.workers)
     trainings = {}

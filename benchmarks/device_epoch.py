@@ -33,6 +33,7 @@ def epoch_seconds(dataset, profile, device: str) -> list[float]:
 def main() -> None:
     bench = Benchmark("device_epoch", __doc__)
     bench.parser.set_defaults(profile="paper")
+    bench.parser._option_string_actions["--profile"].help = "the recipe's profile (default: paper)"
     bench.add_original_data()
     bench.parser.add_argument("--epochs", type=int, default=3, help="epochs per training (>= 2)")
     bench.parser.add_argument("--batches", type=int, nargs="+",
@@ -43,18 +44,19 @@ def main() -> None:
     if args.epochs < 2:
         bench.parser.error(f"--epochs must be at least 2 (the first is warm-up), got {args.epochs}")
     devices = args.devices or ["cpu"] + (["cuda"] if torch.cuda.is_available() else [])
+    base = get_profile(args.profile)                            # resolved once, here
     dataset = load_original(args.original_data)
     rows = []
     for device in devices:
         for batch in args.batches:
-            profile = get_profile(args.profile, seed=args.seeds[0], epochs=args.epochs, batch_size=batch)
+            profile = get_profile(base, seed=args.seeds[0], epochs=args.epochs, batch_size=batch)
             times = epoch_seconds(dataset, profile, device)
             row = {"device": device, "batch": batch, "first_epoch_s": round(times[0], 2),
                    "s_per_epoch": round(sum(times[1:]) / len(times[1:]), 2),
                    "steps_per_epoch": -(-len(dataset.split("train")) // batch)}
             rows.append(row)
             print(row, flush=True)
-    bench.write({"data": "original", "epochs": args.epochs, "cell": get_profile(args.profile).model.cell,
+    bench.write({"data": "original", "epochs": args.epochs, "cell": base.model.cell,
                  "rows": rows})
 
 

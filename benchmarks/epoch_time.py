@@ -5,8 +5,9 @@
 
 On the authors' data (648 training samples), with the real training loop
 (:func:`pgae_lite.train.loop.train`). A candidate is one or more options of the
-recipe's model (:class:`~pgae_lite.config.ModelConfig`) or training
-(:class:`~pgae_lite.config.TrainConfig`), ``KEY=VALUE`` joined by commas. Each
+recipe's model (:class:`~pgae_lite.model.config.ModelConfig`) or training
+(:class:`~pgae_lite.train.config.TrainConfig`), ``KEY=VALUE`` joined by commas (plain
+values: not a recipe's parts, such as ``language`` or ``supervision``). Each
 setting trains ``--epochs`` epochs (the first, a warm-up, is not counted); the
 settings take turns, ``--rounds`` times over, so that a slow spell of a
 shared machine falls on all of them. Reports each setting's fastest epoch and
@@ -21,12 +22,14 @@ import time
 from dataclasses import fields, replace
 
 from harness import Benchmark, key_value
-from pgae_lite.config import ModelConfig, TrainConfig, get_profile
+from pgae_lite.config import Profile, get_profile
 from pgae_lite.data.original import load_original
+from pgae_lite.model.config import PARTS, ModelConfig
+from pgae_lite.train.config import TRAIN_PARTS, TrainConfig
 from pgae_lite.train.loop import train
 
-MODEL_OPTIONS = {f.name for f in fields(ModelConfig)}
-TRAIN_OPTIONS = {f.name for f in fields(TrainConfig)} - {"epochs", "seed", "max_train_samples"}
+MODEL_OPTIONS = {f.name for f in fields(ModelConfig)} - set(PARTS)
+TRAIN_OPTIONS = {f.name for f in fields(TrainConfig)} - {"epochs", "seed", "max_train_samples", *TRAIN_PARTS}
 
 
 def candidate(text: str) -> dict:
@@ -40,9 +43,9 @@ def candidate(text: str) -> dict:
     return changes
 
 
-def epoch_seconds(dataset, profile_name: str, changes: dict, epochs: int) -> list[float]:
+def epoch_seconds(dataset, profile: Profile, changes: dict, epochs: int) -> list[float]:
     """The seconds of each epoch after the first of a training with ``changes`` to the recipe."""
-    prof = get_profile(profile_name, epochs=epochs, **{k: v for k, v in changes.items() if k in TRAIN_OPTIONS})
+    prof = get_profile(profile, epochs=epochs, **{k: v for k, v in changes.items() if k in TRAIN_OPTIONS})
     prof = replace(prof, model=replace(prof.model, **{k: v for k, v in changes.items() if k in MODEL_OPTIONS}))
     marks = [time.perf_counter()]
     train(dataset, prof, progress=False, callback=lambda *_: marks.append(time.perf_counter()))
@@ -58,12 +61,13 @@ def main() -> None:
     args = bench.parse()
     if args.epochs < 2 or args.rounds < 1:
         bench.parser.error("--epochs must be at least 2 (the first warms up) and --rounds at least 1")
+    profile = get_profile(args.profile)                             # resolved once, here
     dataset = load_original(args.original_data)
     settings = [{}] + args.candidates                               # the recipe first
     seconds = [[] for _ in settings]
     for _ in range(args.rounds):
         for times, changes in zip(seconds, settings):
-            times += epoch_seconds(dataset, args.profile, changes, args.epochs)
+            times += epoch_seconds(dataset, profile, changes, args.epochs)
     recipe = min(seconds[0])
     bench.write({"data": "original", "training_samples": len(dataset.split("train")),
                  "rows": [{"changes": changes, "seconds_per_epoch": round(min(times), 3),

@@ -5,47 +5,55 @@
 
 Each (row, seed) is one unit of one sweep, so every row's training time is measured in the
 same run, side by side with PGAE's. PRAE, PVAE, PVAE-BERT and PVAE-BERT-tuned are trained by
-``pgae_lite.family.train.train_family`` and measured configured per task
-(``pgae_lite.family.configured.evaluate_configured``): a cell their configuration cannot
-produce is N.A. (``null``). PGAE, PGAE-BERT and PTAE are Table 1's trainings
-(``pgae_lite.runs.table1_unit``), their models kept in ``--models`` for later experiments.
+the one training loop (``pgae_lite.train.loop.train``, their trainings of ``pgae_lite.runs.rows``),
+in this run, not kept, and measured configured per task (``pgae_lite.evaluate.table1.evaluate``):
+a cell their configuration cannot produce is N.A. (``null``). PGAE, PGAE-BERT and PTAE are
+trained as units of Table 1 (``pgae_lite.runs.table1_unit``), their models kept in ``--models``
+for later experiments.
 Writes results/family-original.json or results/family-ours.json: every seed's cells, each
 cell's median with the worst and best seed, the training time and the parameter count per row.
 """
 from __future__ import annotations
 
 import statistics
+from typing import TYPE_CHECKING
 
 from harness import Benchmark, side_by_side
 
+if TYPE_CHECKING:
+    from pgae_lite.config import Profile
+
 CELLS = ("accuracy", "nrmse")
-CONFIGURED = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned")   # trained by family.train, measured per configuration
+CONFIGURED = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned")   # trained here, not kept; measured per configuration
 TRAINED_AS_PGAE = ("PGAE", "PGAE-BERT", "PTAE")      # Table 1's trainings
 ROWS = (*CONFIGURED, *TRAINED_AS_PGAE)
 
 
-def run(row: str, seed: int, profile_name: str, original_data: str | None, models: str) -> dict:
+def run(row: str, seed: int, profile: Profile, original_data: str | None, models: str) -> dict:
     import torch
 
-    from pgae_lite.bert.encoders import build_pgae
     from pgae_lite.config import get_profile
-    from pgae_lite.family.configured import evaluate_configured
-    from pgae_lite.family.train import family_recipe, train_family
+    from pgae_lite.evaluate.table1 import evaluate
+    from pgae_lite.model.build import build_model
     from pgae_lite.model.pgae import count_parameters
-    from pgae_lite.runs.table1_unit import table1_unit, unit_profile, worker_dataset
+    from pgae_lite.runs.pipeline import unit_profile
+    from pgae_lite.runs.rows import ROWS as BOOK_ROWS
+    from pgae_lite.runs.table1_unit import table1_unit, worker_dataset
+    from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)                  # one core per worker
-    profile = get_profile(profile_name, seed=seed)
+    profile = get_profile(profile, seed=seed)
     data = worker_dataset(original_data, profile, "cpu")
+    training = BOOK_ROWS[row].training
     if row in CONFIGURED:
-        recipe = family_recipe(row, profile.train, profile.name, len(data.split("train")))
-        trained = train_family(row, data, profile.model, recipe, device="cpu")
-        cells, _ = evaluate_configured(trained.model, data, trained.normaliser)
+        prof = training.profile(profile, samples=len(data.split("train")))
+        trained = train(data, prof, device="cpu", progress=False, name=row)
+        cells, _ = evaluate(trained.model, data, trained.normaliser)
         seconds, parameters = trained.seconds, count_parameters(trained.model)
     else:
-        unit = table1_unit(original_data, profile, row, seed, [row], models, "cpu")
+        unit = table1_unit(original_data, profile, training, seed, [BOOK_ROWS[row]], models, "cpu")
         cells, seconds = unit["cells"][row], unit["seconds"]
-        parameters = count_parameters(build_pgae(unit_profile(profile, row, seed).model))
+        parameters = count_parameters(build_model(unit_profile(profile, training, seed, data).model))
     cells = {s: {k: c[k] for k in ("accuracy", "nrmse", "n")} for s, c in cells.items()}
     return {"row": row, "seed": seed, "train_seconds": round(seconds, 1), "parameters": parameters, "cells": cells}
 
@@ -81,7 +89,9 @@ def main() -> None:
     bench.name = f"family-{args.data}"
     original = args.original_data if args.data == "original" else None
     models = f"{args.models}/{args.data}-{args.profile}"
-    jobs = [(row, seed, args.profile, original, models) for row in args.rows for seed in args.seeds]
+    from pgae_lite.config import get_profile
+    profile = get_profile(args.profile)                  # resolved once, here
+    jobs = [(row, seed, profile, original, models) for row in args.rows for seed in args.seeds]
     runs = side_by_side(run, jobs, args.workers)
     table = summary(runs)
     for name, row in table.items():

@@ -37,27 +37,30 @@ from free_language import training_words, words
 from harness import Benchmark, side_by_side
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.bert.pretrained import input_text
-from pgae_lite.config import TRAININGS, Training, get_profile
+from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.config import Profile, get_profile
 from pgae_lite.evaluate.table1 import predict
+from pgae_lite.freeform.attention_pooling import AttentionConfig
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
-from pgae_lite.runs.trainings import PHRASINGS_HELD_OUT
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model
+from pgae_lite.runs.rows import TRAININGS, Training
 
+PHRASINGS_HELD_OUT = TRAININGS["PGAE-BERT-phrasings-held-out"]
 _HELD_OUT = PHRASINGS_HELD_OUT.train
 #: row name -> the training it measures (rows 1 to 4; row 5 is row 4 with its lookup)
 ROWS: dict[str, Training] = {
     "PGAE-BERT": TRAININGS["PGAE-BERT"],
-    "+ phrasings": Training("PGAE-BERT-phrasings-mean-held-out", model={"language_encoder": "pretrained"},
+    "+ phrasings": Training("PGAE-BERT-phrasings-mean-held-out", model={"language": PretrainedConfig()},
                             train=_HELD_OUT),
     "+ attention pooling": Training("PGAE-BERT-phrasings-attention-held-out",
-                                    model={"language_encoder": "pretrained-attention"}, train=_HELD_OUT),
+                                    model={"language": AttentionConfig()}, train=_HELD_OUT),
     "+ tuned top layer": PHRASINGS_HELD_OUT,
 }
 LOOKUP_ROW = "+ word lookup"
 
 
-def measure_as_is(model, data, norm, cae, profile: str, paraphrases, told, unseen) -> dict:
+def measure_as_is(model, data, norm, cae, profile: Profile, paraphrases, told, unseen) -> dict:
     """Readback and open-loop execution by both routes, with the model's encoder as it is now."""
     test = data.split("test")
     texts = [input_text("repeat language", t.text) for t in told]
@@ -66,7 +69,7 @@ def measure_as_is(model, data, norm, cae, profile: str, paraphrases, told, unsee
              "readback_unseen_%": round(100 * float(back.correct[unseen].mean()), 2)}
     for route in ROUTES:
         table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=False, route=route,
-                                    config=get_profile(profile).data, progress=False)
+                                    config=profile.data, progress=False)
         # a refused instruction is not executed: it counts as not done
         passed = table["open_passed"].fillna(False).to_numpy(dtype=bool)
         key = route.replace(" ", "_")
@@ -76,7 +79,7 @@ def measure_as_is(model, data, norm, cae, profile: str, paraphrases, told, unsee
     return cells
 
 
-def run(row: str, seed: int, profile: str) -> list[dict]:
+def run(row: str, seed: int, profile: Profile) -> list[dict]:
     """One training's row (and, for the tuned variant, the lookup's row after it)."""
     torch.set_num_threads(1)                  # one core per worker
     data = simulated_dataset(profile, "cpu", progress=False)
@@ -86,11 +89,11 @@ def run(row: str, seed: int, profile: str) -> list[dict]:
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(test.pattern, test.ids)]
     seen = training_words(PHRASINGS_HELD_OUT.name)         # one "unseen" subset for every row
     unseen = np.array([bool(words(t.text) - seen) for t in told])
-    trained = trained_pgae(ROWS[row], profile, seed, device="cpu", progress=False)
+    trained = trained_model(ROWS[row], profile, seed, device="cpu", progress=False)
     model, norm = trained.model, trained.normaliser
     t0 = time.perf_counter()
     encoder = model.language_encoder
-    lookup = getattr(encoder, "word_lookup", None)
+    lookup = encoder.word_lookup
     if lookup is not None:                    # rows 1 to 4: no lookup
         encoder.word_lookup = None
     rows = [{"row": row, "training": ROWS[row].name, "seed": seed, "train_seconds": round(trained.seconds, 1),
@@ -111,9 +114,10 @@ def main() -> None:
     bench = Benchmark("free_form_ablation", __doc__, seeds=[0, 1, 2])
     bench.add_workers(2, "trainings")
     args = bench.parse()
-    simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
-    trained_cae(args.profile, "cpu", progress=False)
-    jobs = [(row, seed, args.profile) for row in ROWS for seed in args.seeds]
+    profile = get_profile(args.profile)                         # resolved once, here
+    simulated_dataset(profile, "cpu", progress=False)           # recorded once, before the workers start
+    trained_cae(profile, "cpu", progress=False)
+    jobs = [(row, seed, profile) for row in ROWS for seed in args.seeds]
     runs = [r for rows in side_by_side(run, jobs, args.workers) for r in rows]
     bench.write({"rows": [*ROWS, LOOKUP_ROW], "paraphrases": len(load_paraphrases()), "runs": runs})
 

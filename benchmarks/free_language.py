@@ -9,7 +9,7 @@ Both models are trained (or loaded from the cache) on the profile's simulated
 data: ``PGAE-BERT`` reads the dataset's descriptions only; ``PGAE-BERT-phrasings``
 also reads generated sentences that say them in other words
 (:mod:`pgae_lite.freeform.phrasing_bank`). Each of the 216 test episodes is told one of
-the 108 held-out paraphrases of its instruction (``pgae_lite/paraphrases.tsv``,
+the 108 held-out paraphrases of its instruction (``pgae_lite/freeform/paraphrases.tsv``,
 never trained on), and measured three ways:
 
 - *readback*: the paraphrase with ``repeat language``, no pictures of the action
@@ -55,15 +55,15 @@ import torch
 
 from harness import Benchmark, side_by_side
 from pgae_lite.robot.closedloop import variation_of
-from pgae_lite.config import get_profile, training_profile
-from pgae_lite.runs.trainings import by_name
+from pgae_lite.config import Profile, get_profile
+from pgae_lite.runs.rows import training_named
 from pgae_lite.evaluate.table1 import evaluate, predict
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
 from pgae_lite.world.words import SIGNALS, VOCABULARY
 from pgae_lite.data.original import load_original
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import training_lexicon
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model, unit_profile
 from pgae_lite.bert.pretrained import input_text, load_transformer
 from pgae_lite.train.loop import train
 from pgae_lite.util.storage import CACHE_ENV
@@ -76,19 +76,21 @@ def words(text: str) -> set[str]:
 def training_words(training: str) -> set[str]:
     """Every word of the model's training language: signals, descriptions (and phrasings)."""
     seen = set().union(*(words(s) for s in SIGNALS), *(words(w) for w in VOCABULARY))
-    train = by_name(training).train
-    if train.get("phrasings"):
-        seen |= training_lexicon(train.get("phrasing_words", "all")).words()
+    phrasings = training_named(training).train.get("phrasings")
+    if phrasings is not None:
+        seen |= training_lexicon(phrasings.words).words()
     return seen
 
 
-def original_run(training: str, seed: int, profile_name: str, path: str) -> dict:
+def original_run(training: str, seed: int, profile: Profile, path: str) -> dict:
     """One training's canonical Table 1 on the authors' data (resumable under benchmarks/out/)."""
+    from pgae_lite.runs.pipeline import language_source
+
     torch.set_num_threads(1)
     data = load_original(path)
-    profile = training_profile(get_profile(profile_name, seed=seed), by_name(training))
-    out = Path("benchmarks/out") / f"free_language-original-{profile_name}-{training}-s{seed}"
-    trained = train(data, profile, out_dir=out, progress=False)
+    prof = unit_profile(profile, training_named(training), seed, data)
+    out = Path("benchmarks/out") / f"free_language-original-{profile.name}-{training}-s{seed}"
+    trained = train(data, prof, out_dir=out, progress=False, name=training, language=language_source(prof))
     cells, _ = evaluate(trained.model, data, trained.normaliser)
     run = {"training": training, "seed": seed, "train_seconds": round(trained.seconds, 1),
            "table1": {s: {k: round(v, 4) for k, v in c.items()} for s, c in cells.items()}}
@@ -96,36 +98,39 @@ def original_run(training: str, seed: int, profile_name: str, path: str) -> dict
     return run
 
 
-def original_table1(bench: Benchmark, args) -> None:
+def original_table1(bench: Benchmark, args, profile: Profile) -> None:
     """Each training's canonical Table 1 on the authors' data (e.g. for the variant, next to the paper's row)."""
     bench.name = "free_language-original"
-    jobs = [(training, seed, args.profile, args.original_data) for training in args.trainings for seed in args.seeds]
+    jobs = [(training, seed, profile, args.original_data)
+            for training in args.trainings for seed in args.seeds]
     bench.write({"data": "authors'", "runs": side_by_side(original_run, jobs, args.workers)})
 
 
-def training_time(bench: Benchmark, args) -> None:
+def training_time(bench: Benchmark, args, profile: Profile) -> None:
     """Training wall time of the variant against PGAE-BERT's, side by side in this one process."""
     bench.name = "free_language-time"
-    data = simulated_dataset(args.profile, "cpu", progress=False)
+    from pgae_lite.runs.pipeline import language_source
+
+    data = simulated_dataset(profile, "cpu", progress=False)
     load_transformer()                            # loaded once for both, outside the timings
     runs = []
     for seed in args.seeds:
         # the variant first: if the machine's load falls during the run, it favours PGAE-BERT
         for training in ("PGAE-BERT-phrasings", "PGAE-BERT"):
-            profile = training_profile(get_profile(args.profile, seed=seed), by_name(training))
+            prof = unit_profile(profile, training_named(training), seed, data)
             with tempfile.TemporaryDirectory() as empty:
                 os.environ[CACHE_ENV] = empty     # nothing cached: the encoding is timed too
                 t0 = time.perf_counter()
-                train(data, profile, progress=False)
+                train(data, prof, progress=False, name=training, language=language_source(prof))
                 seconds = time.perf_counter() - t0
             runs.append({"training": training, "seed": seed, "seconds": round(seconds, 1),
-                         "epochs": profile.train.epochs})
+                         "epochs": prof.train.epochs})
             print(runs[-1], flush=True)
     total = {t: sum(r["seconds"] for r in runs if r["training"] == t) for t in ("PGAE-BERT", "PGAE-BERT-phrasings")}
     bench.write({"runs": runs, "ratio": round(total["PGAE-BERT-phrasings"] / total["PGAE-BERT"], 2)})
 
 
-def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
+def measure(training: str, seed: int, profile: Profile, closed: bool) -> dict:
     """One model's readback, execution (both routes) and Table 1 on the 216 test episodes."""
     torch.set_num_threads(1)                  # one core per worker: these networks gain nothing from two
     data = simulated_dataset(profile, "cpu", progress=False)
@@ -136,7 +141,7 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
     texts = [input_text("repeat language", t.text) for t in told]   # the readback's inputs
     seen = training_words(training)
     unseen = np.array([bool(words(t.text) - seen) for t in told])
-    trained = trained_pgae(by_name(training), profile, seed, device="cpu", progress=False)
+    trained = trained_model(training_named(training), profile, seed, device="cpu", progress=False)
     model, norm = trained.model, trained.normaliser
     cells, _ = evaluate(model, data, norm)
     t0 = time.perf_counter()
@@ -148,7 +153,7 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
            "readback_unseen_%": round(100 * back.correct[unseen].mean(), 2) if unseen.any() else None,
            "readback_wrong": [{"told": t.text, "understood": x}
                               for t, x, ok in zip(told, back.text, back.correct) if not ok][:40]}
-    lookup = getattr(model.language_encoder, "word_lookup", None)
+    lookup = model.language_encoder.word_lookup
     if lookup is not None:    # the variant: what its WordNet lookup changed, and the readback without it
         run["looked_up"] = dict(sorted({w: p for t in told for w, p in lookup.replacements(t.text).items()}.items()))
         model.language_encoder.word_lookup = None
@@ -159,7 +164,7 @@ def measure(training: str, seed: int, profile: str, closed: bool) -> dict:
             run["readback_unseen_no_lookup_%"] = round(100 * plain.correct[unseen].mean(), 2)
     for route in ROUTES:   # "direct": the paper's execute of the sentence; "said back": its readback's words
         table = execute_paraphrases(model, cae, norm, data, paraphrases, closed=closed, route=route,
-                                    config=get_profile(profile).data, progress=False)
+                                    config=profile.data, progress=False)
         prefix = "" if route == "direct" else "said_back_"
         for loop in ("open", "closed"):
             if f"{loop}_passed" in table:
@@ -181,13 +186,14 @@ def main() -> None:
     bench.add_original_data(None, "the authors' data: each training's canonical Table 1 there, and nothing else")
     bench.parser.add_argument("--time", action="store_true", help="the variant's training time against PGAE-BERT's")
     args = bench.parse()
+    profile = get_profile(args.profile)                         # resolved once, here
     if args.original_data:
-        return original_table1(bench, args)
+        return original_table1(bench, args, profile)
     if args.time:
-        return training_time(bench, args)
-    simulated_dataset(args.profile, "cpu", progress=False)      # recorded once, before the workers start
-    trained_cae(args.profile, "cpu", progress=False)
-    jobs = [(training, seed, args.profile, not args.no_closed) for training in args.trainings for seed in args.seeds]
+        return training_time(bench, args, profile)
+    simulated_dataset(profile, "cpu", progress=False)           # recorded once, before the workers start
+    trained_cae(profile, "cpu", progress=False)
+    jobs = [(training, seed, profile, not args.no_closed) for training in args.trainings for seed in args.seeds]
     runs = side_by_side(measure, jobs, args.workers)
     bench.write({"paraphrases": len(load_paraphrases()), "episodes": runs[0]["episodes"],
                  "routes": list(ROUTES), "runs": runs})

@@ -93,7 +93,9 @@ class Benchmark:
         self.parser.add_argument("--threads", type=int, default=None,
                                  help="torch threads per process (default: torch's, one per core)")
         self.parser.add_argument("--out", default=None, help=f"result file (default: results/{name}.json)")
-        self.parser.add_argument("--profile", default="book", help="the recipe's profile (default: book)")
+        self.parser.add_argument("--profile", default=None,
+                                 help="the recipe's profile: smoke, book or paper "
+                                      "(default: $PGAE_LITE_PROFILE, else book)")
         self.parser.add_argument("--seeds", type=int, nargs="+", default=seeds or [0], help="seeds to run")
         self.args: argparse.Namespace | None = None
 
@@ -118,6 +120,13 @@ class Benchmark:
 
     def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
         self.args = self.parser.parse_args(argv)
+        from pgae_lite.config import profile_name   # here, not at the top: --help stays fast
+        from pgae_lite.util.errors import ArgumentError
+
+        try:      # the name given, else $PGAE_LITE_PROFILE's, else book (checked: an unknown name fails here)
+            self.args.profile = profile_name(self.args.profile)
+        except ArgumentError as e:
+            self.parser.error(str(e))
         if getattr(self.args, "scheduler", None):
             from pgae_lite.runs.sweep import SCHEDULER_ENV
 

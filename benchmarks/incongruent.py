@@ -12,22 +12,27 @@ from __future__ import annotations
 
 import statistics
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from harness import Benchmark, side_by_side
 
+if TYPE_CHECKING:
+    from pgae_lite.config import Profile
 
-def run(model: str, seed: int, profile_name: str, original: str, models: str) -> dict:
+
+def run(model: str, seed: int, profile: Profile, original: str, models: str) -> dict:
     import torch
 
-    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.config import get_profile
     from pgae_lite.evaluate.incongruent import incongruent_cells
-    from pgae_lite.runs.pipeline import train_when_free
+    from pgae_lite.runs.pipeline import train_when_free, unit_profile
+    from pgae_lite.runs.rows import TRAININGS
     from pgae_lite.runs.table1_unit import worker_dataset
 
     torch.set_num_threads(1)
-    profile = get_profile(profile_name, seed=seed)
+    profile = get_profile(profile, seed=seed)
     data = worker_dataset(original, profile, "cpu")
-    prof = training_profile(profile, model)
+    prof = unit_profile(profile, TRAININGS[model], seed, data)
     trained = train_when_free(data, prof, Path(models) / f"{model}-seed{seed}", "cpu", False, model)
     return {"model": model, "seed": seed, "cells": incongruent_cells(trained.model, data, trained.normaliser, seed)}
 

@@ -4,48 +4,52 @@
         [--subset-shares 0.05 0.02] [--seeds 0 1 2] [--workers 2] [--models runs/family]
 
 Each (model, reading, share, seed) is one unit of one sweep. ``--shares``: the share of paired
-updates (``TrainConfig.paired_share``, the PTAE authors' reading); 1 is the recipe itself,
-whose models ``benchmarks/family.py`` trained into the same ``--models`` folder (loaded, not
-trained again). ``--subset-shares``: a fixed labelled share of the samples
-(``TrainConfig.labelled_share``). Every model is measured as Table 1 measures PGAE, on the
-authors' test split. Writes results/limited_supervision.json: every unit's cells and time,
-and per (model, reading, share) each cell's median with the worst and best seed.
+updates (``TrainConfig.supervision = SupervisionConfig(share)``, the PTAE authors' reading); 1 is
+the recipe itself, whose models ``benchmarks/family.py`` trained into the same ``--models`` folder
+(loaded, not trained again). ``--subset-shares``: a fixed labelled share of the samples
+(``SupervisionConfig(share, of="samples")``, :mod:`pgae_lite.train.supervision`). Every model is
+measured as Table 1 measures PGAE, on the authors' test split. Writes results/limited_supervision.json:
+every unit's cells and time, and per (model, reading, share) each cell's median with the worst and best seed.
 """
 from __future__ import annotations
 
 import statistics
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from harness import Benchmark, side_by_side
 
-READINGS = {"updates": "paired_share", "samples": "labelled_share"}
+if TYPE_CHECKING:
+    from pgae_lite.config import Profile
 
 
 def training_of(model: str, reading: str, share: float):
-    """The Training of ``model`` with ``share`` of its steps paired in ``reading`` (1: the model's own)."""
-    from pgae_lite.config import TRAININGS, Training
+    """The Training of ``model`` with ``share`` of its ``reading`` ("updates" or "samples") paired (1: the model's
+    own)."""
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.train.supervision import SupervisionConfig
 
     base = TRAININGS[model]
     if share == 1:
         return base
-    return Training(f"{model}-{reading}-{share:g}", model=base.model,
-                    train={**base.train, READINGS[reading]: share})
+    return replace(base, name=f"{model}-{reading}-{share:g}",
+                   train={**base.train, "supervision": SupervisionConfig(share, of=reading)})
 
 
-def run(model: str, reading: str, share: float, seed: int, profile_name: str, original: str, models: str) -> dict:
+def run(model: str, reading: str, share: float, seed: int, profile: Profile, original: str, models: str) -> dict:
     import torch
 
-    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.config import get_profile
     from pgae_lite.evaluate.table1 import evaluate
-    from pgae_lite.runs.pipeline import train_when_free
+    from pgae_lite.runs.pipeline import train_when_free, unit_profile
     from pgae_lite.runs.table1_unit import worker_dataset
 
     torch.set_num_threads(1)
-    profile = get_profile(profile_name, seed=seed)
+    profile = get_profile(profile, seed=seed)
     data = worker_dataset(original, profile, "cpu")
     training = training_of(model, reading, share)
-    prof = training_profile(replace(profile, train=replace(profile.train, seed=seed)), training)
+    prof = unit_profile(profile, training, seed, data)
     trained = train_when_free(data, prof, Path(models) / f"{training.name}-seed{seed}", "cpu", False, training.name)
     cells, _ = evaluate(trained.model, data, trained.normaliser)
     return {"model": model, "reading": reading, "share": share, "seed": seed,
@@ -79,7 +83,9 @@ def main() -> None:
     args = bench.parse()
     models = f"{args.models}/original-{args.profile}"           # benchmarks/family.py's folder for this data
     settings = [("updates", s) for s in args.shares] + [("samples", s) for s in args.subset_shares]
-    jobs = [(m, reading, share, seed, args.profile, args.original_data, models)
+    from pgae_lite.config import get_profile
+    profile = get_profile(args.profile)                  # resolved once, here
+    jobs = [(m, reading, share, seed, profile, args.original_data, models)
             for reading, share in settings for m in args.models_of for seed in args.seeds]
     runs = side_by_side(run, jobs, args.workers)
     table = summary(runs)

@@ -133,22 +133,24 @@ def both_models(site: str, browser) -> dict:
             "free_text_bytes": sum(n for url, n in received if any(part in url for part in FREE))}
 
 
-def parity(site: str, browser, name: str, manifest: dict, per_kind: int) -> dict:
+def parity(site: str, browser, name: str, manifest: dict, per_kind: int, profile) -> dict:
     """Free text in the page against Python: every paraphrase, each on a test episode with its cube, and
     ``per_kind`` sentences of each kind of benchmarks/refusals.py's grammar, each on a random test episode.
     Python's refusal refuses a text or not; the page must refuse it with the same sentence, or give the
-    same words and readback, and joints within float16 rounding."""
+    same words and readback, and joints within float16 rounding. ``profile``: the Profile the page was exported
+    with (its name is the manifest's)."""
     import random
 
     import numpy as np
     from refusals import CLASSES, sentence
 
     from pgae_lite.freeform.refusals import refusal
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+    from pgae_lite.runs.pipeline import simulated_dataset, trained_model
     from pgae_lite.web.sentence import free_text_reference
 
-    profile, seed = manifest["profile"], manifest["seed"]
-    run = trained_pgae(MODELS[name], profile, seed, device="cpu", progress=False)
+    assert manifest["profile"] == profile.name, (manifest["profile"], profile.name)
+    seed = manifest["seed"]
+    run = trained_model(MODELS[name], profile, seed, device="cpu", progress=False)
     test = simulated_dataset(profile, "cpu", progress=False).split("test")
     scenes = [tuple(e["scene"]) for e in manifest["episodes"]]           # the test split's order
     texts, rows, rng = [], [], random.Random(seed)
@@ -197,11 +199,15 @@ def main() -> None:
     args = bench.parse()
     from playwright.sync_api import sync_playwright
 
+    from pgae_lite.config import get_profile
+
+    profile = get_profile(args.profile)                      # resolved once, here
+
     with tempfile.TemporaryDirectory() as tmp:
         site_dir = Path(tmp) / "html"
         shutil.copytree(args.book, site_dir)
         shutil.rmtree(site_dir / "_static" / "web", ignore_errors=True)
-        manifest = export_web(site_dir / "_static" / "web", args.profile, args.seeds[0])
+        manifest = export_web(site_dir / "_static" / "web", profile, args.seeds[0])
         static = site_dir / "_static"
         files = {p.relative_to(static).as_posix(): p.stat().st_size
                  for folder in ("web", "ort", "tokenizers") for p in (static / folder).rglob("*") if p.is_file()}
@@ -210,17 +216,17 @@ def main() -> None:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
             models = [measure(site, browser, name, args.runs) for name in manifest["models"]]
             box = both_models(site, browser)
-            free = [parity(site, browser, name, manifest, args.per_kind)
+            free = [parity(site, browser, name, manifest, args.per_kind, profile)
                     for name, m in manifest["models"].items() if m["reads"] == "features"]
             browser.close()
         server.shutdown()
         # the same parity with the sentence encoder's weights in float32 (export-web --float32): what float16 costs
         shutil.rmtree(site_dir / "_static" / "web")
-        full = export_web(site_dir / "_static" / "web", args.profile, args.seeds[0], simulate=False, half=False)
+        full = export_web(site_dir / "_static" / "web", profile, args.seeds[0], simulate=False, half=False)
         site, server = serve(site_dir)
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
-            free32 = [parity(site, browser, name, full, args.per_kind)
+            free32 = [parity(site, browser, name, full, args.per_kind, profile)
                       for name, m in full["models"].items() if m["reads"] == "features"]
             browser.close()
         server.shutdown()

@@ -1,9 +1,10 @@
 """Teach NICO a new colour, end to end: record, retrain the CAE and PGAE, check.
 
-Runs every step of the book's guided project (appendix A3) once and times it:
-the new episodes (pgae_lite.runs.new_colour.record), the CAE on old + new frames, the
-features of every episode, PGAE built for the enlarged vocabulary, and
-pgae_lite.exercises.check_new_colour on the held-out episodes. It also writes
+Runs every step of the book's guided project (appendix A3) once and times it, through the one
+pipeline (pgae_lite.runs.pipeline) on the profile in the new world (pgae_lite.config.with_world):
+the new episodes (pgae_lite.sim.dataset.generate of the world's own recordings,
+DatasetConfig.parts()), the CAE on old + new frames, the features of every episode, PGAE built
+for the enlarged vocabulary, and pgae_lite.exercises.check_new_colour on the held-out episodes. It also writes
 Table 1's cells on the paper's 36 test patterns and on the new ones, and the
 reference errors the check's execute threshold is argued from (what following
 the wrong cube's or the wrong action's mean trajectory costs).
@@ -64,29 +65,35 @@ def main() -> None:
 
     import torch
 
-    from pgae_lite.runs import new_colour as extended
+    from pgae_lite.config import get_profile, with_world
     from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.exercises import check_new_colour
+    from pgae_lite.runs import pipeline
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.sim.dataset import generate
 
     world = with_colour(args.colour, args.synonym, args.rgba)
     overrides = {"epochs": args.epochs} if args.epochs else {}
-    cae = extended.cae_path(world, args.profile)
-    folder = extended.pgae_folder(world, args.profile, args.seeds[0], **overrides)
+    coloured = with_world(get_profile(args.profile, **overrides), world)     # resolved once, here
+    seed, training = args.seeds[0], TRAININGS["PGAE"]
+    cae = pipeline.cae_path(coloured.data, coloured.cae)
+    # PGAE's recipe with the seed (unit_profile's, without the data: PGAE's authors count no iterations)
+    folder = pipeline.model_folder(training.profile(get_profile(coloured, seed=seed)), training.name)
     cached = {"cae": cae.exists(),                      # True: the step only loads
               "features": (cae.parent.parent / "features" / f"{cae.stem}.npz").exists(),
               "pgae": (folder / "checkpoint.pt").exists()}
     seconds, t = {}, time.perf_counter()
-    report = extended.record(world, args.profile, progress=False)
+    # the world's own episodes (the last of its parts); the paper's come from the profile's cache
+    report = generate(coloured.data.parts()[-1], progress=False)
     seconds["record"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
-    extended.trained_cae(world, args.profile, progress=False)
+    pipeline.trained_cae(coloured, progress=False)
     seconds["cae"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
-    data = extended.extended_dataset(world, args.profile, progress=False)
+    data = pipeline.simulated_dataset(coloured, progress=False)
     seconds["features"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
-    trained = extended.trained_pgae(world, args.profile, seed=args.seeds[0],
-                                    progress=False, **overrides)
+    trained = pipeline.trained_model(training, coloured, seed, progress=False)
     seconds["pgae"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
     check = check_new_colour(trained.model, trained.normaliser, data, args.colour)

@@ -18,7 +18,7 @@ how the gap between the views closes as the model learns (results/opposite_scale
 
 Each model is evaluated on the test split on both views (PGAE-self and PGAE-opposite);
 beside the cells, how much of [-1, 1] the other agent's motion covers after scaling
-(``opposite_spread``, :func:`pgae_lite.runs.opposite_scale.spread_of`). Our data's models are cached
+(``opposite_spread``, :func:`pgae_lite.data.normaliser.spread_of`). Our data's models are cached
 as every training is; the authors' data's runs resume under benchmarks/out/. Writes
 results/opposite_scale-ours.json or opposite_scale-original.json (one dataset asked for),
 else results/opposite_scale.json.
@@ -30,12 +30,12 @@ from pathlib import Path
 import torch
 
 from harness import Benchmark, side_by_side
-from pgae_lite.config import TRAININGS, Training, get_profile, training_profile
+from pgae_lite.config import Profile, get_profile
+from pgae_lite.data.normaliser import Normaliser, spread_of
 from pgae_lite.data.original import load_original
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import evaluate, predict
-from pgae_lite.data.normaliser import spread_of
-from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+from pgae_lite.runs.pipeline import simulated_dataset, trained_model, unit_profile
+from pgae_lite.runs.rows import TRAININGS, Training
 from pgae_lite.train.loop import train
 
 VIEWS = TRAININGS["PGAE-views"]
@@ -48,17 +48,17 @@ def views_with(scaling: str) -> Training:
     return Training(f"PGAE-views-{scaling}", train={**VIEWS.train, "vision_scaling": scaling})
 
 
-def run(source: str, scaling: str, seed: int, profile_name: str, path: str) -> dict:
+def run(source: str, scaling: str, seed: int, profile: Profile, path: str) -> dict:
     torch.set_num_threads(1)                  # one core per worker
     chosen = views_with(scaling)
     if source == "ours":
-        data = simulated_dataset(profile_name, "cpu", progress=False)
-        trained = trained_pgae(chosen, profile_name, seed, device="cpu", progress=False)
+        data = simulated_dataset(profile, "cpu", progress=False)
+        trained = trained_model(chosen, profile, seed, device="cpu", progress=False)
     else:
         data = load_original(path)
-        profile = training_profile(get_profile(profile_name, seed=seed), chosen)
-        out = Path("benchmarks/out") / f"opposite_scale-{profile_name}-{chosen.name}-s{seed}"
-        trained = train(data, profile, out_dir=out, progress=False)
+        prof = unit_profile(profile, chosen, seed, data)
+        out = Path("benchmarks/out") / f"opposite_scale-{profile.name}-{chosen.name}-s{seed}"
+        trained = train(data, prof, out_dir=out, progress=False)
     cells = {}
     for view, opposite in (("self", False), ("opposite", True)):
         result, _ = evaluate(trained.model, data, trained.normaliser, opposite=opposite)
@@ -70,11 +70,11 @@ def run(source: str, scaling: str, seed: int, profile_name: str, path: str) -> d
     return row
 
 
-def curve(source: str, seed: int, profile_name: str, path: str, epochs: list[int]) -> dict:
+def curve(source: str, seed: int, profile: Profile, path: str, epochs: list[int]) -> dict:
     """One training of the recipe's two-view model; describe on both views at ``epochs``."""
     torch.set_num_threads(1)
-    data = simulated_dataset(profile_name, "cpu", progress=False) if source == "ours" else load_original(path)
-    profile = training_profile(get_profile(profile_name, seed=seed), VIEWS)
+    data = simulated_dataset(profile, "cpu", progress=False) if source == "ours" else load_original(path)
+    profile = unit_profile(profile, VIEWS, seed, data)
     normaliser = Normaliser.fit(data.split("train"), profile.train.vision_scaling)   # the training's own
     test = data.split("test")
     points = []
@@ -99,19 +99,20 @@ def main() -> None:
     bench.parser.add_argument("--curve", type=int, nargs="+", metavar="EPOCH",
                               help="describe on both views at these epochs of one training per seed")
     args = bench.parse()
+    profile = get_profile(args.profile)                          # resolved once, here
     if args.curve:
         bench.name = "opposite_scale-curve"
         if "ours" in args.data:
-            simulated_dataset(args.profile, "cpu", progress=False)
-        jobs = [(source, seed, args.profile, args.original_data, args.curve)
+            simulated_dataset(profile, "cpu", progress=False)
+        jobs = [(source, seed, profile, args.original_data, args.curve)
                 for source in args.data for seed in args.seeds]
         return bench.write({"training": VIEWS.name, "epochs": args.curve,
                             "runs": side_by_side(curve, jobs, args.workers)})
     if len(args.data) == 1:
         bench.name = f"opposite_scale-{args.data[0]}"
     if "ours" in args.data:
-        simulated_dataset(args.profile, "cpu", progress=False)       # recorded once, before the workers start
-    jobs = [(source, scaling, seed, args.profile, args.original_data)
+        simulated_dataset(profile, "cpu", progress=False)            # recorded once, before the workers start
+    jobs = [(source, scaling, seed, profile, args.original_data)
             for source in args.data for scaling in args.scalings for seed in args.seeds]
     rows = side_by_side(run, jobs, args.workers)
     bench.write({"training": VIEWS.name, "runs": rows})

@@ -4,44 +4,44 @@
 
 Each row trains on the authors' data under the ``paper`` profile, exactly as ``reproduce --profile
 paper`` would train it (PRAE, PVAE and PVAE-BERT(-tuned): their authors' iterations, batch and rate,
-``pgae_lite.family.train.family_recipe``; PGAE, PGAE-BERT: the PGAE paper's; PTAE: its own
-authors' width, dropout and 2,500 epochs, ``Training.paper_model``/``paper_train``), but for
+``Training.authors_steps``; PGAE, PGAE-BERT: the PGAE paper's; PTAE: its own authors' width,
+dropout and 2,500 epochs, ``Training.authors_model``/``authors_train``; ``pgae_lite.runs.rows``), but for
 ``--epochs`` epochs only, one core each. ``s_per_epoch`` is the time of those epochs over their
 number; ``projected_h`` the whole recipe's epochs at that rate, in hours, on this machine. Writes
 results/paper_cost.json.
 """
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from harness import Benchmark, side_by_side
+
+if TYPE_CHECKING:
+    from pgae_lite.config import Profile
 
 CONFIGURED = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned")
 ROWS = (*CONFIGURED, "PGAE", "PGAE-BERT", "PTAE")
 
 
-def run(row: str, epochs: int, profile_name: str, original_data: str) -> dict:
+def run(row: str, epochs: int, profile: Profile, original_data: str) -> dict:
     from dataclasses import replace
 
     import torch
 
     from pgae_lite.config import get_profile
-    from pgae_lite.family.train import train_family
     from pgae_lite.model.pgae import count_parameters
-    from pgae_lite.runs.configured_unit import configured_profile
-    from pgae_lite.runs.table1_unit import unit_profile, worker_dataset
+    from pgae_lite.runs.pipeline import unit_profile
+    from pgae_lite.runs.rows import ROWS as BOOK_ROWS
+    from pgae_lite.runs.table1_unit import worker_dataset
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)                  # one core per worker
-    base = get_profile(profile_name, seed=0)
+    base = get_profile(profile, seed=0)
     data = worker_dataset(original_data, base, "cpu")
     samples = len(data.split("train"))
-    if row in CONFIGURED:
-        prof = configured_profile(base, row, 0, samples)
-        short = replace(prof.train, epochs=epochs)
-        trained = train_family(row, data, prof.model, short, device="cpu")
-    else:
-        prof = unit_profile(base, row, 0)
-        trained = train(data, replace(prof, train=replace(prof.train, epochs=epochs)), device="cpu",
-                        progress=False)
+    prof = unit_profile(base, BOOK_ROWS[row].training, 0, data)        # the authors' recipe, under paper
+    trained = train(data, replace(prof, train=replace(prof.train, epochs=epochs)), device="cpu",
+                    progress=False, name=row)
     per_epoch = trained.seconds / epochs
     steps = -(-samples // prof.train.batch_size)
     return {"row": row, "epochs": prof.train.epochs, "batch": prof.train.batch_size, "lr": prof.train.lr,
@@ -53,6 +53,7 @@ def run(row: str, epochs: int, profile_name: str, original_data: str) -> dict:
 def main() -> None:
     bench = Benchmark("paper_cost", __doc__, seeds=[0])
     bench.parser.set_defaults(profile="paper")
+    bench.parser._option_string_actions["--profile"].help = "the recipe's profile (default: paper)"
     bench.add_original_data()
     bench.parser.add_argument("--rows", nargs="+", default=list(ROWS), choices=ROWS)
     bench.parser.add_argument("--epochs", type=int, default=2, help="epochs timed per row (>= 1)")
@@ -62,7 +63,9 @@ def main() -> None:
         bench.parser.error(f"--epochs must be at least 1; got {args.epochs}")
     if not args.original_data:
         bench.parser.error("the paper profile's cost is measured on the authors' data: give --original-data")
-    jobs = [(row, args.epochs, args.profile, args.original_data) for row in args.rows]
+    from pgae_lite.config import get_profile
+    profile = get_profile(args.profile)                  # resolved once, here
+    jobs = [(row, args.epochs, profile, args.original_data) for row in args.rows]
     runs = side_by_side(run, jobs, args.workers)
     for r in runs:
         print(f"{r['row']:16} {r['epochs']:>6} epochs of {r['steps_per_epoch']:>4} steps (batch {r['batch']}): "

@@ -44,7 +44,7 @@ bench.parser.add_argument("--batches", type=int, nargs="+", default=None,
                           help="batch sizes (default: the paper's 6 and the recipe's)")
 bench.parser.add_argument("--epochs", type=int, default=2, help="timed epochs per setting")
 args = bench.parse()
-recipe = get_profile(args.profile)
+recipe = get_profile(args.profile)                   # resolved once, here
 batches = args.batches or sorted({6, recipe.train.batch_size})
 dataset = load_original(args.original_data)
 train_set = dataset.split("train")
@@ -92,7 +92,7 @@ def precision(bf16: bool):
 
 
 def where_time_goes(batch: int, bf16: bool) -> dict:
-    prof = get_profile(args.profile, epochs=1, batch_size=batch)
+    prof = get_profile(recipe, epochs=1, batch_size=batch)
     with profile(activities=[ProfilerActivity.CPU]) as p, precision(bf16):
         train(train_set, prof, progress=False)
     ops = p.key_averages()
@@ -108,7 +108,7 @@ def where_time_goes(batch: int, bf16: bool) -> dict:
             "aten_calls_per_batch": round(calls / math.ceil(len(train_set) / batch))}
 
 
-model_cfg = get_profile(args.profile).model
+model_cfg = recipe.model
 flops = epoch_flops(model_cfg.units, model_cfg.layers, model_cfg.hidden, model_cfg.time_stride)
 peaks = {"float32": peak(torch.float32), "bfloat16": peak(torch.bfloat16)}
 print(f"one epoch: {flops / 1e9:.1f} GFLOP; matmul peak here: float32 {peaks['float32']:.0f}, "
@@ -116,7 +116,7 @@ print(f"one epoch: {flops / 1e9:.1f} GFLOP; matmul peak here: float32 {peaks['fl
 rows = []
 for batch in batches:
     for bf16 in (False, True):
-        prof = get_profile(args.profile, epochs=1 + args.epochs, batch_size=batch)
+        prof = get_profile(recipe, epochs=1 + args.epochs, batch_size=batch)
         times = []
         with precision(bf16):
             train(train_set, prof, progress=False,

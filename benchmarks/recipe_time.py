@@ -31,12 +31,13 @@ PREVIOUS_MODEL = {"time_stride": 1, "gmu_norm": False, "plan_keyframes": 0}
 bench = Benchmark("recipe_time", __doc__)
 bench.add_original_data()
 args = bench.parse()
+base = get_profile(args.profile)                 # resolved once, here
 dataset = load_original(args.original_data)
 
 rows = []
 for seed in args.seeds:
     for name, overrides, model in (("previous", PREVIOUS, PREVIOUS_MODEL), ("book", {}, {})):
-        profile = get_profile(args.profile, seed=seed, **overrides)
+        profile = get_profile(base, seed=seed, **overrides)
         profile.model = replace(profile.model, **model)
         t0 = time.perf_counter()
         trained = train(dataset, profile, progress=False)

@@ -29,8 +29,10 @@ from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import paraphrase_of, say_back, scene_of
 from pgae_lite.freeform.refusals import refusal
-from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
-from pgae_lite.runs.trainings import by_name
+from pgae_lite.config import get_profile
+from pgae_lite.runs.pipeline import simulated_dataset, trained_model
+from pgae_lite.runs.rows import training_named
+from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.patterns import ARRANGEMENTS, pattern_parts
 from pgae_lite.world.words import COLOURS
 
@@ -93,8 +95,13 @@ def main() -> None:
     bench.parser.add_argument("--training", default="PGAE-BERT-phrasings", help="the free-form model")
     bench.parser.add_argument("--per-class", type=int, default=120, help="sentences per class")
     args = bench.parse()
-    data = simulated_dataset(args.profile, "cpu", progress=False)
-    model = trained_pgae(by_name(args.training), args.profile, args.seeds[0], device="cpu", progress=False)
+    try:
+        training = training_named(args.training)
+    except ArgumentError as e:
+        bench.parser.error(str(e))
+    profile = get_profile(args.profile)                      # resolved once, here
+    data = simulated_dataset(profile, "cpu", progress=False)
+    model = trained_model(training, profile, args.seeds[0], device="cpu", progress=False)
     encoder, test = model.model.language_encoder, data.split("test")
     rng = random.Random(args.seeds[0])
 

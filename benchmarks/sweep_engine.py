@@ -7,7 +7,7 @@ The same units (``reproduce``'s: one training of one seed, then its rows measure
 times, each time into a fresh folder, so every unit trains from scratch:
 
 1. ``pool``: a ``concurrent.futures`` process pool of ``--workers`` spawned processes, the way
-   ``trained_pgaes`` and the benchmarks spread their trainings before the sweep;
+   ``trained_models`` and the benchmarks spread their trainings before the sweep;
 2. ``local``: the sweep (``pgae_lite.runs.sweep.run_sweep``) on a Dask ``LocalCluster`` of
    ``--workers`` single-threaded workers, what ``reproduce --seeds N`` does;
 3. ``separate``: the sweep on a ``dask scheduler`` and ``--workers`` ``dask worker`` processes
@@ -134,17 +134,18 @@ def main() -> None:
     bench.parser.add_argument("--runs", default="benchmarks/out/sweep_engine",
                               help="scratch folder (emptied before each engine runs)")
     args = bench.parse()
-    from pgae_lite.config import ROWS, get_profile
+    from pgae_lite.config import get_profile
     from pgae_lite.runs.reproduce import parse_rows
+    from pgae_lite.runs.rows import ROWS
 
     rows, profile = parse_rows(args.rows), get_profile(args.profile)
     source = str(Path(args.original_data).resolve())
-    trainings = list(dict.fromkeys(ROWS[r][0] for r in rows))
+    trainings = list({ROWS[r].training.name: ROWS[r].training for r in rows}.values())
     figures, results = {}, {}
     for name in ("pool", "local", "separate"):
         out = Path(args.runs).resolve() / name
         shutil.rmtree(out, ignore_errors=True)
-        units = [(source, profile, t, seed, [r for r in rows if ROWS[r][0] == t], str(out), "cpu", None)
+        units = [(source, profile, t, seed, [ROWS[r] for r in rows if ROWS[r].training == t], str(out), "cpu", None)
                  for t in trainings for seed in args.seeds]
         # The hand-started cluster is started (and its start timed) before the sweep, as an operator would.
         up = time.time()

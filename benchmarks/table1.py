@@ -15,10 +15,11 @@ import json
 import statistics
 from pathlib import Path
 
-from pgae_lite.config import ROWS, get_profile
+from pgae_lite.config import get_profile
 from pgae_lite.evaluate.table1 import PAPER_TABLE
 from pgae_lite.world.words import TEST_SIGNALS
 from pgae_lite.runs.reproduce import parse_rows, run_table1
+from pgae_lite.runs.rows import ROWS
 
 from harness import Benchmark
 
@@ -55,7 +56,7 @@ def summarise(report: dict, rows: list[str], seeds: list[int], source: str, prof
     summary, lines = {}, []
     head = f"{'':24s}" + "".join(f"{s:>17s}" for s in TEST_SIGNALS) + f"{'train s':>10s}"
     for row in rows:
-        training = ROWS[row][0]
+        training = ROWS[row].training.name
         per_seed = [report["rows"][row]["seeds"][str(s)] for s in seeds]
         seconds = [report["trainings"][training]["train_seconds"][str(s)] for s in seeds]
         stats = {s: {k: {"median": statistics.median(c[s][k] for c in per_seed),

@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 from pgae_lite.world.words import COLOURS
+from pgae_lite.config import get_profile
 from pgae_lite.runs.pipeline import simulated_dataset
 
 
@@ -43,7 +44,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--profile", default="book")
     args = ap.parse_args()
-    ds = simulated_dataset(args.profile)
+    ds = simulated_dataset(get_profile(args.profile))
     left = np.array([COLOURS.index(a.split("+")[0]) for a in ds.arrangement])
     right = np.array([COLOURS.index(a.split("+")[1]) for a in ds.arrangement])
     train, test = ~ds.is_test, ds.is_test

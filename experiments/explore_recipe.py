@@ -42,9 +42,9 @@ def main() -> None:
     a = ap.parse_args()
     torch.set_num_threads(a.threads)
 
-    prof = get_profile("book", epochs=a.epochs, seed=a.seed, **overrides(a.set))
+    prof = get_profile("book", epochs=a.epochs, seed=a.seed, **overrides(a.set))     # resolved once, here
     prof.model = replace(prof.model, **overrides(a.model))
-    ds = simulated_dataset("book", progress=False) if a.sim else load_original(a.original_data)
+    ds = simulated_dataset(prof, progress=False) if a.sim else load_original(a.original_data)
     t0 = time.perf_counter()
     rows = []
 

@@ -12,8 +12,9 @@ a second time from the same h reading only the first frame, v_0, at every step, 
 
 ``--detach`` holds the decoder's weights fixed in that pass, so its gradient reaches h only.
 With ``--sim --save DIR`` it then runs ``episodes`` test episodes open and closed loop
-(:func:`pgae_lite.robot.closedloop.compare`). It patches the training loop, which is why it is an
-experiment and not an option of the package.
+(:func:`pgae_lite.robot.closedloop.compare`). It patches PGAE's forward pass and the loss its
+training reads (:func:`pgae_lite.model.loss.pgae_loss`), which is why it is an experiment and not
+an option of the package.
 """
 import argparse
 import sys
@@ -21,8 +22,7 @@ from pathlib import Path
 
 import torch
 
-import pgae_lite.train.loop as training
-from pgae_lite.train.checkpoint import load_model
+import pgae_lite.model.loss as losses
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import EXECUTE, REPEAT_ACTION, REPEAT_BOTH
 
@@ -31,7 +31,7 @@ import explore_recipe  # noqa: E402
 
 
 def install(share: float, weight: float, detach: bool) -> None:
-    forward, loss = PGAE.forward, training.pgae_loss
+    forward, loss = PGAE.forward, losses.pgae_loss
 
     def forward_with_first_frame(self, batch, *args, **kwargs):
         out = forward(self, batch, *args, **kwargs)
@@ -62,7 +62,7 @@ def install(share: float, weight: float, detach: bool) -> None:
             total = total + beta * weight * err
         return total, lang, act
 
-    PGAE.forward, training.pgae_loss = forward_with_first_frame, loss_with_first_frame
+    PGAE.forward, losses.pgae_loss = forward_with_first_frame, loss_with_first_frame
 
 
 def main() -> None:
@@ -77,10 +77,12 @@ def main() -> None:
     sys.argv = [sys.argv[0], *rest]
     explore_recipe.main()
     if "--sim" in rest and "--save" in rest:
+        from pgae_lite.config import get_profile
         from pgae_lite.robot.closedloop import compare, success_summary
-        from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
-        data = simulated_dataset("book", progress=False)
-        cae, _ = trained_cae("book", progress=False)
+        from pgae_lite.runs.pipeline import load_model, simulated_dataset, trained_cae
+        profile = get_profile("book")                                     # resolved once, here
+        data = simulated_dataset(profile, progress=False)
+        cae, _ = trained_cae(profile, progress=False)
         folder = Path(rest[rest.index("--save") + 1])
         model, normaliser, _ = load_model(next(folder.glob("*.pt")), dataset=data)
         table = compare(model, cae, normaliser, data, limit=ours.episodes, progress=False)

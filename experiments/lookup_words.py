@@ -13,7 +13,7 @@ each of which has a meaning. Two settings:
 
 A word is read *right* (replaced by a phrase of its own meaning), *wrong*
 (another meaning) or *kept* (no single meaning: it stays as it is). Words of
-the test paraphrases (``pgae_lite/paraphrases.tsv``) are left out of both
+the test paraphrases (``pgae_lite/freeform/paraphrases.tsv``) are left out of both
 settings, so that the rule is chosen on words the test never says; the test
 is read only to leave them out.
 """

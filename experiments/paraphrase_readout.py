@@ -6,7 +6,7 @@
 PGAE-BERT reads a sentence only through the frozen transformer. Here small
 classifiers are trained on the transformer's outputs for the sentences
 PGAE-BERT can be trained on, and tested on the 108 held-out paraphrases
-(``pgae_lite/paraphrases.tsv``): they predict action, colour and speed, and a
+(``pgae_lite/freeform/paraphrases.tsv``): they predict action, colour and speed, and a
 paraphrase counts when all three are right. Two read-outs:
 
 - ``sentence``: one linear layer on the mean-pooled sentence vector, the

@@ -4,7 +4,7 @@
 
 PGAE-BERT sees a paraphrase only as the transformer's sentence vector. Before
 blaming (or crediting) PGAE, ask the transformer itself: for each of the 108
-held-out paraphrases (``pgae_lite/paraphrases.tsv``), which of the 288
+held-out paraphrases (``pgae_lite/freeform/paraphrases.tsv``), which of the 288
 fixed-vocabulary inputs "execute ACTION COLOUR SPEED" that PGAE-BERT was
 trained on has the most similar sentence vector (cosine)? Its meaning is
 counted right when action, colour and speed all match; each slot is also

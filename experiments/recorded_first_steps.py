@@ -17,20 +17,22 @@ import numpy as np
 import torch
 
 from pgae_lite.cae import extract_features
-from pgae_lite.robot.closedloop import _drive, _simulation, _start, execute_batch, spread, variation_of
-from pgae_lite.config import PROFILES
+from pgae_lite.robot.closedloop import _drive, _start, execute_batch, spread, variation_of
+from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import description_text
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
-from pgae_lite.train.checkpoint import load_model
+from pgae_lite.runs.pipeline import load_model, simulated_dataset, trained_cae
+from pgae_lite.sim.record import shared_simulation
+
+PROFILE = get_profile("book")          # resolved once, here
 
 
 @torch.no_grad()
 def run(model, cae, normaliser, test, tensors, i: int, recorded_steps: int) -> bool:
     """Episode i of the test split in closed loop, reading the recorded frames for t < recorded_steps."""
-    config = PROFILES["book"].data
+    config = PROFILE.data
     pattern, variation, length = int(test.pattern[i]), variation_of(test.ids[i]), int(test.lengths[i])
     words = tuple(description_text(test.descriptions[i, i % 8]).split())
-    sim = _simulation(config)
+    sim = shared_simulation(config.sim, config.the_world)
     frame = _start(sim, config, pattern, variation, render=True)
 
     def features(f):
@@ -57,8 +59,8 @@ def main() -> None:
     ap.add_argument("--steps", type=int, nargs="+", default=[0, 6, 12, 20, 30])
     a = ap.parse_args()
     torch.set_num_threads(1)
-    data = simulated_dataset("book", progress=False)
-    cae, _ = trained_cae("book", progress=False)
+    data = simulated_dataset(PROFILE, progress=False)
+    cae, _ = trained_cae(PROFILE, progress=False)
     model, normaliser, _ = load_model(a.checkpoint, dataset=data)
     test = data.split("test")
     tensors = normaliser.tensors(test)

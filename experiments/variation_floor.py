@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from pgae_lite.sim import SimConfig
-from pgae_lite.sim.record import _simulation, episode_seed
+from pgae_lite.sim.record import episode_seed, shared_simulation
 
 OUT = Path(__file__).resolve().parent / "out" / "variation_floor.jsonl"
 JOINT_RANGE = 4.038   # observed range of the book dataset's joints (rad), as evaluate.nrmse divides by
@@ -33,7 +33,7 @@ JOINT_RANGE = 4.038   # observed range of the book dataset's joints (rad), as ev
 
 def spread(config: SimConfig, patterns: range, variations: int = 6) -> float:
     """nRMSE (%) of each pattern's planned trajectories around their mean, steps 1..T."""
-    sim = _simulation(config)
+    sim = shared_simulation(config)
     squares, count = 0.0, 0
     for pattern in patterns:
         plans = []

@@ -33,7 +33,7 @@ from pgae_lite.train.checkpoint import CHECKPOINT, check_trained_on, load_checkp
 from pgae_lite.train.draws import Draws
 from pgae_lite.train.optimiser import lr_factor, parameter_groups
 from pgae_lite.train.supervision import labelled_samples
-from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.errors import ArgumentError, PGAELiteError
 from pgae_lite.util.storage import CheckpointMismatchError, default_device, folder_lock, training_threads
 from pgae_lite.world.words import SIGNALS
 
@@ -120,6 +120,10 @@ def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: to
            progress: bool, model: nn.Module | None, callback, name: str, language) -> Trained:
     cfg = profile.train
     cfg.__post_init__()              # checked again: a field may have been set since
+    if cfg.phrasings is not None and language is None:
+        raise ArgumentError("this recipe trains on phrasings (TrainConfig.phrasings), which the loop does not make "
+                            "itself: hand it their source, train(..., language=pgae_lite.runs.pipeline."
+                            "language_source(profile)), or train through pgae_lite.runs.pipeline.trained_model")
     train_set = training_split(dataset, cfg.max_train_samples)
     normaliser = Normaliser.fit(train_set, cfg.vision_scaling)
     run = _setup(train_set, normaliser, profile, device, model)
