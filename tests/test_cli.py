@@ -174,10 +174,12 @@ def test_unknown_row_and_bad_seed_count_are_clear_errors(capsys):
 def test_cli_profile_names_match_the_package():
     import pgae_lite.config as config
     from pgae_lite.__main__ import FAMILY_ROW_NAMES, PROFILE_ENV, PROFILE_NAMES, ROW_NAMES
-    from pgae_lite.config import FAMILY_ROWS, PROFILES, ROWS
+    from pgae_lite.config import PROFILES
+    from pgae_lite.runs.rows import FAMILY_ROWS, ROWS, TABLE1_ROWS
 
     assert tuple(PROFILES) == PROFILE_NAMES == config.PROFILE_NAMES
-    assert PROFILE_ENV == config.PROFILE_ENV and ROW_NAMES == tuple(ROWS) and FAMILY_ROW_NAMES == tuple(FAMILY_ROWS)
+    assert PROFILE_ENV == config.PROFILE_ENV and ROW_NAMES == tuple(TABLE1_ROWS)
+    assert FAMILY_ROW_NAMES == tuple(FAMILY_ROWS) and ROW_NAMES + FAMILY_ROW_NAMES == tuple(ROWS)
 
 
 def test_help_does_not_import_torch():

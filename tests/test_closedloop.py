@@ -11,7 +11,7 @@ from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_number
 from pgae_lite.model.pgae import ActionDecoder
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
+from pgae_lite.runs.data import simulated_dataset, trained_cae
 from pgae_lite.sim import Execution, Simulation, execute_trajectory
 from pgae_lite.sim.dataset import load_episode
 from pgae_lite.train.loop import train
@@ -42,8 +42,8 @@ def test_stepping_the_decoder_gives_what_forward_gives(cell, feedback, stride):
 @pytest.fixture(scope="module")
 def smoke(smoke_episodes):
     """The smoke dataset, its CAE and a PGAE trained on it for a few seconds."""
-    data = simulated_dataset("smoke", "cpu", progress=False)
-    cae, _ = trained_cae("smoke", "cpu", progress=False)
+    data = simulated_dataset(get_profile("smoke"), "cpu", progress=False)
+    cae, _ = trained_cae(get_profile("smoke"), "cpu", progress=False)
     trained = train(data, get_profile("smoke"), device="cpu", progress=False)
     return data, cae, trained.model, trained.normaliser
 

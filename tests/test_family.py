@@ -1,8 +1,10 @@
-"""The family's parts (pgae_lite/family/): PRAE's and PVAE's binding loss."""
+"""The family (pgae_lite/model/prae.py, pvae.py, binding.py): PRAE's and PVAE's binding loss, their paths,
+their training by the one loop (checkpoints, resume, recipes) and the one evaluation's N.A. cells."""
 from __future__ import annotations
 
 import itertools
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -66,46 +68,89 @@ def test_a_negative_margin_is_refused():
 
 
 # ------------------------------------------------------------------ PRAE
-def prae_inputs(tensors, index, alternative=None):
-    """PRAE's inputs for samples ``index``: the description's words (no signal; ``alternative``: which of
-    the 8, default the first), the action, the targets."""
+def small(name: str = "PRAE", **model):
+    """The model config of a family training (runs/rows.py), smaller: 16 units, one LSTM step per time step."""
+    from pgae_lite.config import ModelConfig
+    from pgae_lite.runs.rows import TRAININGS
+
+    return replace(ModelConfig(units=16, time_stride=1), **{**TRAININGS[name].model, **model})
+
+
+def paired_batch(tensors, index, alternative=None, signal="repeat both"):
+    """A batch of samples ``index`` with one signal (``alternative``: which of the 8 descriptions, default the
+    first)."""
     from pgae_lite.model.signals import make_batch, signal_ids
 
     if alternative is None:
         alternative = torch.zeros(len(index), dtype=torch.long)
-    from pgae_lite.model.prae import paired_inputs
-
-    b = make_batch(tensors, index, signal_ids("repeat both", len(index)), alternative)
-    return paired_inputs(b), b
+    return make_batch(tensors, index, signal_ids(signal, len(index)), alternative)
 
 
 def test_prae_rebuilds_each_modality_from_its_code_and_translates_only_across(toy_tensors):
     from pgae_lite.model.prae import PRAE
-    from pgae_lite.model.config import ModelConfig
 
-    model = PRAE(ModelConfig(units=16))
-    x, b = prae_inputs(toy_tensors, torch.tensor([72, 0, 100, 1]))
-    logits, joints, z_language, z_action = model(**x)
+    model = PRAE(small())
+    index = torch.tensor([72, 0, 100, 1])
+    b = paired_batch(toy_tensors, index)
+    logits, joints, z_language, z_action = model.autoencode(b)
     assert logits.shape == (4, 4, 23) and joints.shape == b.joint_target.shape
-    assert z_language.shape == z_action.shape == (4, 100)
-    assert model.describe(x["inputs"], x["lengths"]).shape == (4, 4, 23)           # words only
-    assert model.execute(x["tokens"], x["token_lengths"], x["vision"], x["start"]).shape == joints.shape
-    torch.testing.assert_close(model.language_code(x["tokens"], x["token_lengths"]), z_language)
+    assert z_language.shape == z_action.shape == (4, 100)                     # the codes: cfg.hidden
+    described = model(paired_batch(toy_tensors, index, signal="describe"))
+    assert set(described) == {"logits"} and described["logits"].shape == (4, 4, 23)      # words only
+    executed = model(paired_batch(toy_tensors, index, signal="execute"))
+    assert set(executed) == {"joints"} and executed["joints"].shape == joints.shape       # joints only
+    assert set(model(b)) == {"logits", "joints"}                               # repeat both: both autoencoders
+    torch.testing.assert_close(model.language_code(b.lang_tokens, b.lang_lengths), z_language)
+    torch.testing.assert_close(model.action_code(b.action_input, b.action_lengths), z_action)
+    assert PRAE(small(hidden=12)).to_language_code.out_features == 12          # SHARED_DIM is cfg.hidden
+
+
+def test_prae_is_configured_per_direction_and_needs_its_binding(toy_tensors):
+    from pgae_lite.config import ModelConfig
+    from pgae_lite.model.prae import PRAE, BindingConfig
+    from pgae_lite.model.signals import make_batch, signal_ids
+
+    model = PRAE(small())
+    mixed = make_batch(toy_tensors, torch.tensor([0, 1]), signal_ids(["describe", "execute"]), torch.tensor([0, 0]))
+    with pytest.raises(ValueError, match="give it a batch of one signal; got describe, execute"):
+        model(mixed)
+    with pytest.raises(ValueError, match="PRAE binds two autoencoders: its ModelConfig needs binding=BindingConfig"):
+        PRAE(ModelConfig(units=16, plan_keyframes=0))
+    default = PRAE()
+    assert default.cfg.binding == BindingConfig() and default.cfg.hidden == 100 and default.cfg.plan_keyframes == 0
+
+
+def test_build_model_builds_the_model_its_parts_describe():
+    """Which model a config builds follows from its parts, never from a name."""
+    from pgae_lite.config import get_profile
+    from pgae_lite.model.build import build_model
+    from pgae_lite.model.pgae import PGAE
+    from pgae_lite.model.prae import PRAE
+    from pgae_lite.model.ptae import PTAE
+    from pgae_lite.model.pvae import PVAE
+    from pgae_lite.runs.rows import TRAININGS
+
+    smoke = get_profile("smoke")
+    built = {name: type(build_model(TRAININGS[name].profile(smoke).model)) for name in ("PGAE", "PRAE", "PRAE-8",
+                                                                                         "PVAE", "PTAE")}
+    assert built == {"PGAE": PGAE, "PRAE": PRAE, "PRAE-8": PRAE, "PVAE": PVAE, "PTAE": PTAE}
+    assert PRAE.PATHS["describe"] == ("words",) and PRAE.PATHS["execute"] == ("joints",)
+    assert all(paths == ("words", "joints") for paths in PGAE.PATHS.values())
 
 
 def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(toy_short):
     from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.prae import PRAE
-    from pgae_lite.model.config import ModelConfig
 
     torch.manual_seed(0)
     tensors = Normaliser.fit(toy_short.split("train")).tensors(toy_short)
-    model = PRAE(ModelConfig(units=16, time_stride=1))
+    model = PRAE(small())
     optimiser = torch.optim.Adam(model.parameters(), lr=3e-3)
-    x, b = prae_inputs(tensors, torch.arange(24))
+    index = torch.arange(24)
+    b = paired_batch(tensors, index)
 
     def losses():
-        logits, joints, z_language, z_action = model(**x)
+        logits, joints, z_language, z_action = model.autoencode(b)
         words = torch.nn.functional.cross_entropy(logits.transpose(1, 2), b.lang_target)
         mse = ((joints - b.joint_target) ** 2)[b.joint_mask].mean()
         return words, mse, binding_loss(z_language, z_action)
@@ -120,27 +165,63 @@ def test_prae_learns_both_reconstructions_and_the_binding_and_describes_across(t
         optimiser.step()
     last = [v.item() for v in losses()]
     assert all(b_ < a / 2 for a, b_ in zip(first, last)), (first, last)
+    model.eval()
     with torch.no_grad():                          # bound: the action's code reads out as its description
-        described = model.describe(x["inputs"], x["lengths"]).argmax(-1)
+        described = model(paired_batch(tensors, index, signal="describe"))["logits"].argmax(-1)
     assert (described == b.lang_target).all(1).float().mean().item() == 1.0
-    check_the_configured_cells(model, toy_short, tensors)
+    check_the_configured_cells(model, toy_short)
 
 
-def check_the_configured_cells(model, data, tensors):
+def check_the_configured_cells(model, data):
     """Table 1's cells of a configured model: words or joints per signal, N.A. (None) for the rest."""
     from pgae_lite.data.normaliser import Normaliser
-    from pgae_lite.family.configured import configured_predictions, evaluate_configured
+    from pgae_lite.evaluate.table1 import evaluate, predict
 
     normaliser = Normaliser.fit(data.split("train"))
-    cells, preds = evaluate_configured(model, data, normaliser, split="train")
+    cells, preds = evaluate(model, data, normaliser, split="train")
     for signal, words in (("describe", True), ("repeat language", True), ("execute", False), ("repeat action", False)):
         assert (cells[signal]["accuracy"] is None) != words, signal
         assert (cells[signal]["nrmse"] is None) == words, signal
         assert cells[signal]["n"] == len(data.split("train"))
     assert math.isfinite(cells["execute"]["nrmse"]) and 0 <= cells["describe"]["accuracy"] <= 100
     assert all(t == "" for t in preds["execute"].text) and np.isnan(preds["describe"].joints).all()
-    trained = configured_predictions(model, data.subset(np.arange(24)), normaliser, "describe")
+    trained = predict(model, data.subset(np.arange(24)), normaliser, "describe")
     assert trained.correct.all()                   # the samples it trained on, described across
+
+
+def test_the_evaluation_writes_na_exactly_where_a_model_has_no_path(toy_short):
+    """One evaluation for every model: a cell is None exactly where the model's PATHS has no output for it."""
+    from pgae_lite.config import ModelConfig
+    from pgae_lite.data.normaliser import Normaliser
+    from pgae_lite.evaluate.table1 import evaluate, format_table
+    from pgae_lite.model.pgae import PGAE
+    from pgae_lite.model.prae import PRAE
+    from pgae_lite.model.ptae import CrossmodalConfig, PTAE
+    from pgae_lite.model.pvae import PVAE
+    from pgae_lite.world.words import TEST_SIGNALS
+
+    normaliser = Normaliser.fit(toy_short.split("train"))
+    models = {"PGAE": PGAE(ModelConfig(units=8)), "PTAE": PTAE(ModelConfig(units=8, hidden=16,
+                                                                          crossmodal=CrossmodalConfig())),
+              "PRAE": PRAE(small()), "PVAE": PVAE(small("PVAE"))}
+    results = {}
+    for name, model in models.items():
+        cells, preds = evaluate(model, toy_short, normaliser)
+        results[name] = cells
+        for signal in TEST_SIGNALS:
+            writes = model.PATHS[signal]
+            assert (cells[signal]["accuracy"] is None) == ("words" not in writes), (name, signal)
+            assert (cells[signal]["nrmse"] is None) == ("joints" not in writes), (name, signal)
+            assert (cells[signal]["nrmse_padded"] is None) == ("joints" not in writes), (name, signal)
+            assert cells[signal]["n"] == len(toy_short.split("test"))
+            assert np.isnan(preds[signal].joints).all() == ("joints" not in writes), (name, signal)
+    for name in ("PGAE", "PTAE"):                                      # every cell
+        assert all(v is not None for c in results[name].values() for v in c.values()), name
+    for name in ("PRAE", "PVAE"):
+        assert results[name]["describe"]["accuracy"] is not None and results[name]["describe"]["nrmse"] is None
+        assert results[name]["execute"]["nrmse"] is not None and results[name]["execute"]["accuracy"] is None
+    table = format_table(results)
+    assert table.count("N.A.") == 8                                   # PRAE's and PVAE's: 2 rows x 2 x 2 tables
 
 
 # ------------------------------------------------------------------ PVAE
@@ -173,16 +254,15 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
     describes each action with one of its 8 (the one-to-many translation PRAE was not made for)."""
     from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.pvae import BINDING_WEIGHT, KL_WEIGHT, PVAE, kl_divergence
-    from pgae_lite.model.config import ModelConfig
 
     torch.manual_seed(0)
     tensors = Normaliser.fit(toy_short.split("train")).tensors(toy_short)
-    model = PVAE(ModelConfig(units=16, time_stride=1))
+    model = PVAE(small("PVAE"))
     optimiser = torch.optim.Adam(model.parameters(), lr=3e-3)
     index = torch.arange(24)
     for _ in range(500):
-        x, b = prae_inputs(tensors, index, alternative=torch.randint(0, 8, (24,)))
-        logits, joints, mean_l, mean_a, log_var_l, log_var_a = model(**x)
+        b = paired_batch(tensors, index, alternative=torch.randint(0, 8, (24,)))
+        logits, joints, mean_l, mean_a, log_var_l, log_var_a = model.autoencode(b)
         loss = (torch.nn.functional.cross_entropy(logits.transpose(1, 2), b.lang_target)
                 + ((joints - b.joint_target) ** 2)[b.joint_mask].mean()
                 + BINDING_WEIGHT * binding_loss(mean_l, mean_a)
@@ -190,35 +270,75 @@ def test_pvae_learns_one_action_from_its_eight_descriptions(toy_short):
         optimiser.zero_grad()
         loss.backward()
         optimiser.step()
+    model.eval()
     with torch.no_grad():
-        words = model.describe(x["inputs"], x["lengths"]).argmax(-1)[:, :3]             # (24, 3)
+        words = model(paired_batch(tensors, index, signal="describe"))["logits"].argmax(-1)[:, :3]   # (24, 3)
     one_of_eight = (words[:, None] == tensors["descriptions"][index]).all(-1).any(-1)   # (24,)
     assert one_of_eight.all(), one_of_eight
 
 
-# ------------------------------------------------------------------ training the family
-@pytest.mark.parametrize("name", ["PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned"])
-def test_train_family_lowers_every_term_and_is_seeded(toy_short, name):
-    from pgae_lite.family.train import train_family
-    from pgae_lite.model.config import ModelConfig
-    from pgae_lite.train.config import TrainConfig
+# ------------------------------------------------------------------ training the family by the one loop
+def family_profile(name: str, epochs: int = 6, **train):
+    """A small recipe of the family training ``name`` (runs/rows.py), for the one training loop."""
+    from pgae_lite.config import Profile, TrainConfig
+    from pgae_lite.runs.rows import TRAININGS
 
-    recipe = TrainConfig(epochs=6, batch_size=16, input_noise=0.0, joint_input_noise=0.0)
-    cfg = ModelConfig(units=16, time_stride=1)
-    first = train_family(name, toy_short, cfg, recipe, device="cpu")
+    base = Profile("tiny", small(), TrainConfig(epochs=epochs, batch_size=16, input_noise=0.0, joint_input_noise=0.0,
+                                                checkpoint_every=1, **train))
+    return TRAININGS[name].profile(base)
+
+
+@pytest.mark.parametrize("name", ["PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned"])
+def test_the_loop_trains_the_family_lowers_every_term_and_is_seeded(toy_short, name):
+    from pgae_lite.train.loop import train
+
+    prof = family_profile(name, epochs=12)    # 12: PVAE's words fall slowly at first (its codes are sampled)
+    first = train(toy_short, prof, device="cpu", progress=False, name=name)
     words, joints = [[h[k] for h in first.history] for k in ("words", "joints")]
     assert words[-1] < words[0] and joints[-1] < joints[0]
-    assert (first.history[-1]["kl"] > 0) == name.startswith("PVAE")     # PRAE has no KL term
-    again = train_family(name, toy_short, cfg, recipe, device="cpu")
+    assert set(first.history[-1]) == {"epoch", "loss", "words", "joints", "binding", "lr", "gate"} | (
+        {"kl"} if name.startswith("PVAE") else set())                  # PRAE has no KL term
+    assert first.history[-1]["gate"] == {}                             # no GMU
+    if name.startswith("PVAE"):
+        assert first.history[-1]["kl"] > 0
+    again = train(toy_short, prof, device="cpu", progress=False, name=name)
     assert again.history == first.history                               # the same seed, the same numbers
 
 
-def test_an_unknown_family_model_is_refused(toy_short):
-    from pgae_lite.family.train import train_family
+@pytest.mark.parametrize("name", ["PRAE", "PVAE"])
+def test_the_family_gets_checkpoints_and_resumes_bit_for_bit(toy_short, tmp_path, interrupt_training, name):
+    """The smoke recipe of PRAE and PVAE through the one loop: a run stopped after its 2nd of 3 epochs (the 3rd
+    unsaved) and resumed gives the weights of the run trained at once, bit for bit."""
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
+    from pgae_lite.train.loop import train
 
-    options = "PRAE, PVAE, PVAE-BERT, PVAE-BERT-tuned"
-    with pytest.raises(ValueError, match=f"unknown family model 'PTAE'; the options are: {options}"):
-        train_family("PTAE", toy_short)
+    prof = TRAININGS[name].profile(get_profile("smoke", epochs=3, max_train_samples=48, batch_size=16))
+    assert prof.train.checkpoint_every == 1 and prof.model.binding is not None
+    whole = train(toy_short, prof, out_dir=tmp_path / "whole", device="cpu", progress=False)
+    assert load_checkpoint(tmp_path / "whole" / CHECKPOINT)["epoch"] == 3
+    interrupt_training(toy_short, prof, tmp_path / "cut", epoch=3)
+    saved = load_checkpoint(tmp_path / "cut" / CHECKPOINT)
+    assert saved["epoch"] == 2 and saved["profile"] == prof.to_dict()
+    epochs_run = []
+    resumed = train(toy_short, prof, out_dir=tmp_path / "cut", device="cpu", progress=False,
+                    callback=lambda epoch, *_: epochs_run.append(epoch))
+    assert epochs_run == [3]                                           # only the unsaved epoch again
+    assert resumed.history == whole.history
+    first, second = whole.model.state_dict(), resumed.model.state_dict()
+    assert first.keys() == second.keys() and all(torch.equal(first[k], second[k]) for k in first)
+    other = train(toy_short, TRAININGS[name].profile(get_profile("smoke", epochs=3, max_train_samples=48,
+                                                                 batch_size=16, seed=1)), device="cpu", progress=False)
+    assert other.history != whole.history                              # a test that can fail: the seed counts
+
+
+def test_build_model_refuses_a_binding_with_a_plan_head():
+    from pgae_lite.config import ModelConfig
+    from pgae_lite.model.prae import BindingConfig
+
+    with pytest.raises(ValueError, match="PRAE and PVAE have no plan head"):
+        ModelConfig(binding=BindingConfig())                          # plan_keyframes=10, the book's default
 
 
 def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(toy_short):
@@ -226,32 +346,26 @@ def test_pvae_bert_reads_the_description_through_the_frozen_pretrained_encoder(t
     from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, tokens_to_text
     from pgae_lite.data.normaliser import Normaliser
     from pgae_lite.model.pvae import PVAE
-    from pgae_lite.family.train import train_family
-    from pgae_lite.model.config import ModelConfig
-    from pgae_lite.train.config import TrainConfig
+    from pgae_lite.train.loop import train
 
-    trained = train_family("PVAE-BERT", toy_short, ModelConfig(units=16, time_stride=1),
-                           TrainConfig(epochs=2, batch_size=16), device="cpu")
+    trained = train(toy_short, family_profile("PVAE-BERT", epochs=2), device="cpu", progress=False)
     model = trained.model
     assert isinstance(model, PVAE) and isinstance(model.language_encoder, PretrainedLanguageEncoder)
     assert model.to_language_code.in_features == model.language_encoder.output_dim == 384
     assert not any(p.requires_grad for p in model.language_encoder.parameters())
     tensors = Normaliser.fit(toy_short.split("train")).tensors(toy_short)
-    x, _ = prae_inputs(tensors, torch.tensor([0, 5]))
-    assert tokens_to_text(x["tokens"][0]).startswith("repeat both ")
-    expected = model.to_language_code(model.language_encoder.encode_texts([tokens_to_text(r) for r in x["tokens"]]))
-    torch.testing.assert_close(model.language_code(x["tokens"], x["token_lengths"]), expected, atol=1e-5, rtol=1e-4)
+    b = paired_batch(tensors, torch.tensor([0, 5]))
+    assert tokens_to_text(b.lang_tokens[0]).startswith("repeat both ")
+    expected = model.to_language_code(model.language_encoder.encode_texts([tokens_to_text(r) for r in b.lang_tokens]))
+    torch.testing.assert_close(model.language_code(b.lang_tokens, b.lang_lengths), expected, atol=1e-5, rtol=1e-4)
 
 
 def test_pvae_bert_tuned_trains_its_top_layer_and_nothing_below(toy_short):
     from pgae_lite.bert.tuned_encoder import TunedPretrainedEncoder
-    from pgae_lite.family.train import train_family
-    from pgae_lite.model.config import ModelConfig
-    from pgae_lite.train.config import TrainConfig
+    from pgae_lite.train.loop import train
 
-    cfg, recipe = ModelConfig(units=16, time_stride=1), TrainConfig(epochs=2, batch_size=16)
     untrained = TunedPretrainedEncoder()
-    trained = train_family("PVAE-BERT-tuned", toy_short, cfg, recipe, device="cpu").model
+    trained = train(toy_short, family_profile("PVAE-BERT-tuned", epochs=2), device="cpu", progress=False).model
     assert isinstance(trained.language_encoder, TunedPretrainedEncoder)
     before, after = untrained.top.state_dict(), trained.language_encoder.top.state_dict()
     assert any(not torch.equal(before[k], after[k]) for k in before)     # the top layer learned
@@ -259,19 +373,25 @@ def test_pvae_bert_tuned_trains_its_top_layer_and_nothing_below(toy_short):
 
 
 # ------------------------------------------------------------------ the chapter's models and tables
-def test_family_models_trains_the_chapters_three_and_ptae_is_cached():
-    from pgae_lite.model.pvae import PVAE
+def test_the_chapters_three_models_train_side_by_side_and_ptae_is_cached():
+    from pgae_lite.config import get_profile
     from pgae_lite.model.prae import PRAE
     from pgae_lite.model.ptae import PTAE
-    from pgae_lite.runs.family_models import family_models
+    from pgae_lite.model.pvae import PVAE
+    from pgae_lite.runs.pipeline import model_folder, trained_models
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.train.checkpoint import CHECKPOINT
 
-    models = family_models("smoke", seed=0, device="cpu", progress=False, workers=1)
-    assert set(models) == {"PRAE-8", "PVAE", "PTAE"}
+    trainings, profile = [TRAININGS[n] for n in ("PRAE-8", "PVAE", "PTAE")], get_profile("smoke")
+    models = trained_models(trainings, profile, seed=0, device="cpu", progress=False, workers=1)
+    assert list(models) == ["PRAE-8", "PVAE", "PTAE"]
     assert type(models["PRAE-8"].model) is PRAE and isinstance(models["PVAE"].model, PVAE)
-    assert isinstance(models["PTAE"].model, PTAE)
-    again = family_models("smoke", seed=0, device="cpu", progress=False, workers=1)
+    assert models["PRAE-8"].model.cfg.binding.all_descriptions and isinstance(models["PTAE"].model, PTAE)
+    checkpoints = {name: model_folder(trained.profile, name) / CHECKPOINT for name, trained in models.items()}
+    written = {name: path.stat().st_mtime_ns for name, path in checkpoints.items()}
+    again = trained_models(trainings, profile, seed=0, device="cpu", progress=False, workers=1)
     assert again["PRAE-8"].history == models["PRAE-8"].history          # the cached model
-    assert again["PRAE-8"].seconds == models["PRAE-8"].seconds           # loaded, not trained again
+    assert {name: path.stat().st_mtime_ns for name, path in checkpoints.items()} == written   # loaded, not trained
     first, second = models["PTAE"].model.state_dict(), again["PTAE"].model.state_dict()
     assert all(torch.equal(first[k], second[k]) for k in first)         # PTAE: the cached model
 
@@ -297,15 +417,18 @@ def test_the_family_table_marks_na_and_gives_median_and_range(tmp_path, monkeypa
 
 def test_the_paper_profile_trains_each_family_model_as_its_authors_did():
     from pgae_lite.config import get_profile
-    from pgae_lite.family.train import family_recipe
+    from pgae_lite.runs.rows import TRAININGS
 
-    paper, book = get_profile("paper").train, get_profile("book").train
-    assert family_recipe("PRAE", book, "book", 864) is book                 # the book's recipe is everyone's
-    prae = family_recipe("PRAE", paper, "paper", 864)
+    paper, book = get_profile("paper"), get_profile("book")
+    prae_book = TRAININGS["PRAE"].profile(book, samples=864).train
+    assert prae_book == replace(book.train, length_batches=False)       # the book's recipe is everyone's
+    prae = TRAININGS["PRAE"].profile(paper, samples=864).train
     assert (prae.batch_size, prae.lr, prae.epochs) == (50, 1e-3, round(20_000 * 50 / 864))
-    pvae = family_recipe("PVAE", paper, "paper", 864)
+    pvae = TRAININGS["PVAE"].profile(paper, samples=864).train
     assert (pvae.batch_size, pvae.lr, pvae.epochs) == (100, 1e-4, round(15_000 * 100 / 864))
     assert (pvae.weight_decay, pvae.schedule, pvae.clip) == (0.0, "constant", None)   # Adam, as the paper's
+    bert = TRAININGS["PVAE-BERT-tuned"].profile(paper, samples=864).train
+    assert (bert.batch_size, bert.lr, bert.epochs) == (100, 1e-4, round(40_000 * 100 / 864))
 
 
 def test_reproduce_takes_a_configured_row_writes_na_as_null_and_loads_its_model_again(original_data, tmp_path):
@@ -325,22 +448,35 @@ def test_reproduce_takes_a_configured_row_writes_na_as_null_and_loads_its_model_
     with np.load(tmp_path / "predictions.npz") as predictions:
         assert np.isnan(predictions["describe_joints"]).all()                  # no joints while describing
         assert (predictions["execute_text"] == "").all()                       # no words while executing
-    saved = (tmp_path / "PVAE-seed0" / "family.pt").stat().st_mtime_ns
+    checkpoint = tmp_path / "PVAE-seed0" / "checkpoint.pt"                      # the one loop's checkpoint
+    assert not (tmp_path / "PVAE-seed0" / "family.pt").exists()
+    saved = checkpoint.stat().st_mtime_ns
     again = reproduce(original_data, **args)                                    # loaded, not trained again
-    assert (tmp_path / "PVAE-seed0" / "family.pt").stat().st_mtime_ns == saved
+    assert checkpoint.stat().st_mtime_ns == saved
     assert again["rows"]["PVAE"]["mean"] == report["rows"]["PVAE"]["mean"]
 
 
-def test_a_model_saved_by_an_older_training_code_is_refused_not_loaded(toy_short, tmp_path):
+def test_a_family_model_of_an_older_recipe_version_is_refused_not_loaded(toy_short, tmp_path):
+    """A PRAE checkpoint whose recipe has an older RECIPE_VERSION: load_model refuses it, and the loop will not
+    resume from it."""
     from pgae_lite.config import get_profile
-    from pgae_lite.runs.configured_unit import configured_profile, trained_configured
+    from pgae_lite.runs.pipeline import load_model
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.train.checkpoint import CHECKPOINT, CHECKPOINT_KEYS
+    from pgae_lite.train.config import RECIPE_VERSION
+    from pgae_lite.train.loop import train
     from pgae_lite.util.storage import CheckpointMismatchError, load_torch, save_torch
 
-    prof = configured_profile(get_profile("smoke"), "PRAE", 0, len(toy_short.split("train")))
-    path = tmp_path / "PRAE-seed0" / "family.pt"
-    trained_configured(path, "PRAE", prof, toy_short, "cpu")
-    saved = load_torch(path, ("name", "training_version"), "family model")
-    saved["training_version"] = 1                                               # as the first version saved it
+    prof = TRAININGS["PRAE"].profile(get_profile("smoke", epochs=1, max_train_samples=16, batch_size=16))
+    path = tmp_path / "PRAE-seed0" / CHECKPOINT
+    trained = train(toy_short, prof, out_dir=path.parent, device="cpu", progress=False)
+    model, _, _ = load_model(path, device="cpu", dataset=toy_short)             # this version's: loaded
+    assert type(model) is type(trained.model)
+    saved = load_torch(path, CHECKPOINT_KEYS)
+    saved["profile"]["recipe_version"] = RECIPE_VERSION - 1                     # as the family code saved it
     save_torch(saved, path)
-    with pytest.raises(CheckpointMismatchError, match="trained by an older training code .version 1"):
-        trained_configured(path, "PRAE", prof, toy_short, "cpu")
+    with pytest.raises(CheckpointMismatchError, match=f"trained with recipe version {RECIPE_VERSION - 1}; "
+                                                      f"this pgae_lite reads version {RECIPE_VERSION}"):
+        load_model(path, device="cpu")
+    with pytest.raises(CheckpointMismatchError, match="different profile"):
+        train(toy_short, prof, out_dir=path.parent, device="cpu", progress=False)

@@ -30,7 +30,7 @@ from pgae_lite.robot.instructions import instruction_features
 from pgae_lite.world.words import (BOS_EOS, SLOTS, SYNONYMS, VOCABULARY, LanguageError,
                                 decode, encode, one_hot, parse_description)
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.runs.pipeline import simulated_dataset
+from pgae_lite.runs.data import simulated_dataset
 from pgae_lite.robot.playground import (PlayResult, Playground, action_label,
                                   arrangement_label, find_episode, pattern_number, play,
                                   simulator_config)
@@ -67,7 +67,7 @@ def tiny(toy):
     (["--epochs", "-5"], "--epochs must be a whole number >= 1; got -5"),
     (["--original-data", ""], "--original-data is empty"),       # was: simulated data
     (["--out", ""], "--out is empty"),
-    (["--pretrained-model", "my/model"], "--pretrained-model 'my/model' is PGAE-BERT"),
+    (["--pretrained-model", "my/model"], "--pretrained-model 'my/model' is the pretrained language model of PGAE-BERT"),
     (["--device", "garbage"], "--device 'garbage' is not a torch device; use cpu"),
     (["--seeds", "1000000000000"], "--seeds must be a whole number from 1 to 100"),
     (["--seed", str(2 ** 32)], "--seed must be a whole number from 0 to 4294967295"),
@@ -126,10 +126,12 @@ def test_every_error_of_the_package_is_a_pgae_lite_error():
 def test_an_unknown_profile_is_clear_from_every_entry_point(monkeypatch):
     listed = "the profiles are: smoke, book, paper"
     monkeypatch.delenv(PROFILE_ENV, raising=False)
-    for call in (lambda: get_profile("garbage"), lambda: profile_name(5),
-                 lambda: simulated_dataset("garbage")):
+    for call in (lambda: get_profile("garbage"), lambda: profile_name(5)):
         with pytest.raises(ArgumentError, match=listed):
             call()
+    with pytest.raises(ArgumentTypeError, match="profile must be a Profile, resolved once where the run starts: "
+                                                "pgae_lite.config.get_profile\\(name\\); got str 'garbage'"):
+        simulated_dataset("garbage")                      # below the entry points a profile is a value
     monkeypatch.setenv(PROFILE_ENV, "garbage")
     with pytest.raises(ArgumentError, match=f"variable {PROFILE_ENV}.*{listed}"):
         get_profile()

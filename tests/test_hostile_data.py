@@ -34,8 +34,11 @@ from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.data.original import load_original
 from pgae_lite.sim.dataset import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.model.pgae import PGAE
+from pgae_lite.runs import data as run_data
 from pgae_lite.runs import pipeline
-from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint, load_model
+from pgae_lite.runs.pipeline import load_model
+from pgae_lite.runs.rows import TRAININGS
+from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 from pgae_lite.train.loop import NonFiniteLossError, train
 from pgae_lite.util.storage import (
     LOCK_FILE,
@@ -193,28 +196,29 @@ def test_a_features_file_is_checked_before_use(toy, tmp_path):
 
 
 def test_a_bad_features_cache_is_computed_again(smoke_episodes, toy):
-    data = pipeline.simulated_dataset("smoke", progress=False)
-    [path] = pipeline.cache_dir().glob("features/*.npz")
+    smoke = get_profile("smoke")
+    data = run_data.simulated_dataset(smoke, progress=False)
+    [path] = run_data.cache_dir().glob("features/*.npz")
     replace(data, vision=np.full_like(data.vision, np.nan)).save(path)   # NaN, no stamp
     with pytest.warns(UserWarning, match="saved without a fingerprint"):
-        again = pipeline.simulated_dataset("smoke", progress=False)
+        again = run_data.simulated_dataset(smoke, progress=False)
     np.testing.assert_array_equal(again.vision, data.vision)
     toy.save(path, fingerprint="another dataset's")
     with pytest.warns(UserWarning, match="fingerprint \"another dataset's\""):
-        again = pipeline.simulated_dataset("smoke", progress=False)
+        again = run_data.simulated_dataset(smoke, progress=False)
     np.testing.assert_array_equal(again.vision, data.vision)
 
 
-SMALL = dict(max_train_samples=8, batch_size=4, epochs=1)
+SMALL = get_profile("smoke", max_train_samples=8, batch_size=4, epochs=1)
 
 
 def _cached_pgae(toy_short, monkeypatch, seed: int):
     """A tiny PGAE trained into the cache, and its checkpoint's path. (The toy dataset stands in
     for the simulated one, as in test_pipeline.)"""
-    monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short)
-    before = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT))
-    first = pipeline.trained_pgae("PGAE", "smoke", seed=seed, progress=False, **SMALL)
-    [path] = set(pipeline.cache_dir().glob("pgae/*/" + CHECKPOINT)) - before
+    monkeypatch.setattr(pipeline, "loaded", lambda *a, **k: toy_short)
+    before = set(run_data.cache_dir().glob("pgae/*/" + CHECKPOINT))
+    first = pipeline.trained_model(TRAININGS["PGAE"], SMALL, seed=seed, progress=False)
+    [path] = set(run_data.cache_dir().glob("pgae/*/" + CHECKPOINT)) - before
     return first, path
 
 
@@ -222,7 +226,7 @@ def test_a_damaged_cached_pgae_is_trained_again(toy_short, monkeypatch):
     first, path = _cached_pgae(toy_short, monkeypatch, seed=5)
     path.write_bytes(path.read_bytes()[:1000])
     with pytest.warns(UserWarning, match="training it again: .* truncated or damaged"):
-        again = pipeline.trained_pgae("PGAE", "smoke", seed=5, progress=False, **SMALL)
+        again = pipeline.trained_model(TRAININGS["PGAE"], SMALL, seed=5, progress=False)
     assert again.history == first.history
 
 
@@ -234,7 +238,7 @@ def test_a_cached_pgae_with_other_data_statistics_is_trained_again(toy_short, mo
     ckpt["normaliser"]["vision_opposite"] = [lo - 1.0, hi + 1.0]
     save_torch(ckpt, path)
     with pytest.warns(UserWarning, match=r"training it again: .*\(vision_opposite\)"):
-        again = pipeline.trained_pgae("PGAE", "smoke", seed=6, progress=False, **SMALL)
+        again = pipeline.trained_model(TRAININGS["PGAE"], SMALL, seed=6, progress=False)
     assert again.history == first.history and load_checkpoint(path)["normaliser"]["vision_opposite"] == [lo, hi]
 
 

@@ -16,6 +16,7 @@ import torch
 
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.runs import results
+from pgae_lite.runs.rows import TABLE1_ROWS
 from pgae_lite.world.words import LanguageError
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -80,7 +81,7 @@ def test_the_books_table1_is_read_through_the_same_checks(tmp_path, monkeypatch,
 def test_the_books_table1_of_the_committed_result_is_unchanged():
     frame = results.table1_frame("table1-original")
     assert frame.shape == (16, 8) and np.isfinite(frame.to_numpy(dtype=float)).all()
-    assert results.table1_met("table1-original") == {row: True for row in results.ROWS}
+    assert results.table1_met("table1-original") == {row: True for row in TABLE1_ROWS}
     with pytest.raises(KeyError, match="has no row 'PGAE-X'; it has: PGAE, PGAE-BERT"):
         results.table1_frame("table1-original", ["PGAE-X"])
 
@@ -137,7 +138,7 @@ def test_a_dataset_file_is_checked_for_what_its_arrays_hold(tmp_path, toy, chang
 
 def test_a_cached_file_with_the_right_stamp_but_an_integer_split_is_made_again(tmp_path, toy):
     # An integer is_test would select samples by index: split("test") took all 144 samples.
-    from pgae_lite.runs.pipeline import cached_dataset
+    from pgae_lite.runs.data import cached_dataset
     from pgae_lite.util.storage import config_digest
 
     configs = {"data": "the configs that make it"}
@@ -246,15 +247,21 @@ def test_the_real_pattern_files_are_the_worlds(original_data):
 
 
 # --------------------------------------------------------------------------- a dataset without test samples
-def test_trained_pgae_refuses_a_dataset_without_test_samples_before_training(toy_short, monkeypatch):
+def test_trained_model_refuses_a_dataset_without_test_samples_before_training(toy_short, monkeypatch):
+    from pgae_lite.config import get_profile
     from pgae_lite.runs import pipeline
+    from pgae_lite.runs.rows import TRAININGS
 
     def never(*args, **kwargs):
         raise AssertionError("training started")
 
-    monkeypatch.setattr(pipeline, "simulated_dataset", lambda *a, **k: toy_short.subset(~toy_short.is_test))
+    monkeypatch.setattr(pipeline, "loaded", lambda *a, **k: toy_short.subset(~toy_short.is_test))
     monkeypatch.setattr("pgae_lite.train.loop.train", never)
+    monkeypatch.setattr(pipeline, "run_sweep", never)
+    smoke = get_profile("smoke")
+    for training in (TRAININGS["PGAE"], TRAININGS["PRAE"]):
+        with pytest.raises(DataFormatError, match="has no test samples"):
+            pipeline.trained_model(training, smoke, progress=False)
     with pytest.raises(DataFormatError, match="has no test samples"):
-        pipeline.trained_pgae("PGAE", "smoke", progress=False)
-    with pytest.raises(DataFormatError, match="has no test samples"):
-        pipeline.trained_pgaes(["PGAE", "PGAE-BERT"], "smoke", device="cpu", progress=False, workers=2)
+        pipeline.trained_models([TRAININGS["PGAE"], TRAININGS["PGAE-BERT"]], smoke, device="cpu", progress=False,
+                                workers=2)

@@ -108,7 +108,8 @@ def test_the_built_in_profiles_pass_their_own_checks():
 # --------------------------------------------------------------------------- checkpoints
 def test_a_checkpoint_with_non_finite_weights_is_refused(tmp_path, toy_short):
     from pgae_lite.config import get_profile
-    from pgae_lite.train.checkpoint import CHECKPOINT, load_model
+    from pgae_lite.runs.pipeline import load_model
+    from pgae_lite.train.checkpoint import CHECKPOINT
     from pgae_lite.train.loop import train
     from pgae_lite.util.storage import CorruptCheckpointError
 

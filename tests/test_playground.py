@@ -14,7 +14,9 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
+from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.freeform.attention_pooling import AttentionConfig
+from pgae_lite.model.build import build_model
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
 from pgae_lite.robot.closedloop import pattern_for
 from pgae_lite.data.normaliser import Normaliser
@@ -179,7 +181,7 @@ needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(m) is None
 @needs_bert
 def test_pgae_bert_reads_free_text(toy):
     torch.manual_seed(0)
-    model = build_pgae(ModelConfig(units=16, hidden=8, language_encoder="pretrained",
+    model = build_model(ModelConfig(units=16, hidden=8, language=PretrainedConfig(),
                                    joint_feedback="predicted")).eval()
     normaliser = Normaliser.fit(toy.split("train"))
     text = "please shove the azure block away from you, slowly"
@@ -222,7 +224,7 @@ def test_pgae_bert_reads_free_text(toy):
 def test_the_variant_shows_the_words_its_lookup_replaced(toy):
     """A variant with a word lookup (word_lookup.py) reads, and shows, the text with its unknown words replaced."""
     torch.manual_seed(0)
-    model = build_pgae(ModelConfig(units=16, hidden=8, language_encoder="pretrained-attention",
+    model = build_model(ModelConfig(units=16, hidden=8, language=AttentionConfig(),
                              joint_feedback="predicted")).eval()
     model.language_encoder.word_lookup = WordLookup(LEXICON)
     normaliser = Normaliser.fit(toy.split("train"))

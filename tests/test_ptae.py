@@ -9,16 +9,17 @@ import pytest
 import torch
 
 from pgae_lite.model.config import ModelConfig
+from pgae_lite.model.ptae import CrossmodalConfig
 from pgae_lite.model.signals import make_batch, signal_ids
 
-SMALL = ModelConfig(units=16, hidden=32, heads=4, feedforward=64, bottleneck="crossmodal-transformer")
+SMALL = ModelConfig(units=16, hidden=32, crossmodal=CrossmodalConfig(heads=4, feedforward=64))
 
 
 def ptae(cfg=SMALL, seed=0):
-    from pgae_lite.bert.encoders import build_pgae
+    from pgae_lite.model.build import build_model
 
     torch.manual_seed(seed)
-    return build_pgae(cfg).eval()
+    return build_model(cfg).eval()
 
 
 def batch_of(tensors, signal, index=(0, 72, 100, 1)):
@@ -27,11 +28,12 @@ def batch_of(tensors, signal, index=(0, 72, 100, 1)):
 
 
 def test_the_recipe_builds_ptae_and_it_answers_as_pgae_does(toy_tensors):
-    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.config import get_profile
     from pgae_lite.model.ptae import PTAE
+    from pgae_lite.runs.rows import TRAININGS
 
-    prof = training_profile(get_profile("book"), "PTAE")
-    assert prof.model.bottleneck == "crossmodal-transformer" and prof.model.hidden == 128
+    prof = TRAININGS["PTAE"].profile(get_profile("book"))
+    assert prof.model.crossmodal == CrossmodalConfig() and prof.model.hidden == 128
     model = ptae()
     assert isinstance(model, PTAE)
     b = batch_of(toy_tensors, "describe")
@@ -84,14 +86,16 @@ def test_positional_encoding_is_the_transformers_sinusoids():
 
 
 def test_ptae_trains_in_pgaes_loop_learns_and_loads_from_its_checkpoint(toy_short, tmp_path):
-    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.config import get_profile
     from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.model.ptae import PTAE
-    from pgae_lite.train.checkpoint import load_model
+    from pgae_lite.runs.pipeline import load_model
+    from pgae_lite.runs.rows import TRAININGS
     from pgae_lite.train.loop import train
 
-    prof = training_profile(get_profile("smoke", epochs=20, max_train_samples=None, batch_size=16), "PTAE")
-    prof = replace(prof, model=replace(prof.model, hidden=32, feedforward=64))
+    prof = TRAININGS["PTAE"].profile(get_profile("smoke", epochs=20, max_train_samples=None, batch_size=16))
+    prof = replace(prof, model=replace(prof.model, hidden=32, crossmodal=replace(prof.model.crossmodal,
+                                                                                  feedforward=64)))
     trained = train(toy_short, prof, out_dir=tmp_path, device="cpu", progress=False)
     losses = [r["loss"] for r in trained.history]
     assert losses[-1] < losses[0] / 2 and all("gate" in r for r in trained.history)
@@ -103,15 +107,25 @@ def test_ptae_trains_in_pgaes_loop_learns_and_loads_from_its_checkpoint(toy_shor
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"bottleneck": "attention"}, "unknown bottleneck 'attention'; the options are: gmu, crossmodal-transformer"),
+    ({"crossmodal": "attention"}, "ModelConfig crossmodal must be None or a part's settings"),
     ({"hidden": 30}, "hidden must be a multiple of heads"),
-    ({"language_encoder": "pretrained"}, "reads the words as tokens itself"),
-    ({"dropout": 1.0}, r"dropout must be a number in \[0, 1\)"),
-    ({"heads": 0}, "heads must be a whole number >= 1"),
+    ({"language": "pretrained"}, "ModelConfig language must be None or a part's settings"),
+    ({"crossmodal": {"dropout": 1.0}}, r"CrossmodalConfig dropout must be a number in \[0, 1\)"),
+    ({"crossmodal": {"heads": 0}}, "CrossmodalConfig heads must be a whole number >= 1"),
 ])
 def test_a_wrong_transformer_setting_is_refused(change, message):
     with pytest.raises(ValueError, match=message):
-        replace(SMALL, **change)
+        if isinstance(change.get("crossmodal"), dict):               # a setting of the part itself
+            replace(SMALL, crossmodal=replace(SMALL.crossmodal, **change["crossmodal"]))
+        else:
+            replace(SMALL, **change)
+
+
+def test_a_language_encoder_is_refused_beside_the_transformer():
+    from pgae_lite.bert.config import PretrainedConfig
+
+    with pytest.raises(ValueError, match="reads the words as tokens itself"):
+        replace(SMALL, language=PretrainedConfig())
 
 
 def test_ptae_reads_no_free_text(toy_tensors):
@@ -119,23 +133,24 @@ def test_ptae_reads_no_free_text(toy_tensors):
 
     model = ptae()
     assert model.language_encoder.reads_free_text is False
-    with pytest.raises(LanguageError, match="PTAE reads only the dataset's words"):
+    with pytest.raises(LanguageError, match="reads only the dataset's words, as tokens"):
         model.language_encoder.encode_texts(["push the red cube"])
     with pytest.raises(LanguageError, match="not precomputed language features"):
         model(batch_of(toy_tensors, "execute"), language=torch.zeros(4, 32))
 
 
 def test_the_paper_profile_builds_the_authors_ptae_and_the_book_its_own():
-    from pgae_lite.config import get_profile, training_profile
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.rows import TRAININGS
 
-    paper = training_profile(get_profile("paper"), "PTAE")
-    assert (paper.model.hidden, paper.model.feedforward, paper.model.dropout, paper.model.frame_positions) \
-        == (256, 1024, 0.25, False)
+    paper = TRAININGS["PTAE"].profile(get_profile("paper"))
+    part = paper.model.crossmodal
+    assert (paper.model.hidden, part.feedforward, part.dropout, part.frame_positions) == (256, 1024, 0.25, False)
     assert (paper.train.epochs, paper.train.batch_size, paper.train.lr) == (2500, 6, 1e-5)
-    book = training_profile(get_profile("book"), "PTAE")
-    assert (book.model.hidden, book.model.feedforward, book.model.dropout, book.model.frame_positions) \
-        == (128, 512, 0.0, True)
-    assert training_profile(get_profile("paper"), "PGAE").train.epochs == 6000      # PGAE keeps its own
+    book = TRAININGS["PTAE"].profile(get_profile("book"))
+    part = book.model.crossmodal
+    assert (book.model.hidden, part.feedforward, part.dropout, part.frame_positions) == (128, 512, 0.0, True)
+    assert TRAININGS["PGAE"].profile(get_profile("paper")).train.epochs == 6000      # PGAE keeps its own
 
 
 def test_reproduce_takes_the_ptae_row_and_writes_todays_files(original_data, tmp_path):
@@ -150,7 +165,7 @@ def test_reproduce_takes_the_ptae_row_and_writes_todays_files(original_data, tmp
     report = json.loads((tmp_path / "results.json").read_text())
     row = report["rows"]["PTAE"]
     assert row["paper"] is None and row["training"] == "PTAE"            # not a row of the paper's Table 1
-    assert report["trainings"]["PTAE"]["profile"]["model"]["bottleneck"] == "crossmodal-transformer"
+    assert report["trainings"]["PTAE"]["profile"]["model"]["crossmodal"]["kind"] == "crossmodal-transformer"
     with np.load(tmp_path / "predictions.npz") as predictions:          # today's format: every cell recomputable
         assert {f"{s}_{k}" for s in ("describe", "execute", "repeat_action", "repeat_language")
                 for k in ("ids", "text", "joints")} == set(predictions.files)

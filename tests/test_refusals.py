@@ -112,10 +112,13 @@ needs_bert = pytest.mark.skipif(any(importlib.util.find_spec(p) is None
 @pytest.fixture(scope="module")
 def bert(smoke_episodes):
     """The smoke data, its CAE and the pipeline's PGAE-BERT (cached)."""
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_pgae
+    from pgae_lite.runs.data import simulated_dataset, trained_cae
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.runs.rows import TRAININGS
 
-    return (simulated_dataset("smoke", "cpu", progress=False), trained_cae("smoke", "cpu", progress=False)[0],
-            trained_pgae("PGAE-BERT", "smoke", 0, device="cpu", progress=False))
+    smoke = get_profile("smoke")
+    return (simulated_dataset(smoke, "cpu", progress=False), trained_cae(smoke, "cpu", progress=False)[0],
+            trained_model(TRAININGS["PGAE-BERT"], smoke, 0, device="cpu", progress=False))
 
 
 @needs_bert

@@ -73,9 +73,10 @@ def test_config_key_changes_with_the_config():
 
 
 def test_simulated_dataset_has_the_authors_layout(smoke_episodes):
-    from pgae_lite.runs.pipeline import simulated_dataset
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.data import simulated_dataset
 
-    ds = simulated_dataset("smoke", progress=False)
+    ds = simulated_dataset(get_profile("smoke"), progress=False)
     n = len(SMOKE_PATTERNS)
     assert isinstance(ds, PGAEDataset) and len(ds) == n
     assert ds.joints.shape == (n, 100, 5) and ds.vision.shape == ds.vision_opposite.shape == (n, 100, 30)
@@ -84,7 +85,7 @@ def test_simulated_dataset_has_the_authors_layout(smoke_episodes):
     assert ds.descriptions.shape == (n, 8, 3)
     assert ds.is_test.tolist() == [Pattern.from_number(p).is_test for p in ds.pattern]
     assert not np.allclose(ds.vision, ds.vision_opposite)
-    again = simulated_dataset("smoke", progress=False)                 # from the features cache
+    again = simulated_dataset(get_profile("smoke"), progress=False)                 # from the features cache
     np.testing.assert_array_equal(again.vision, ds.vision)
 
 

@@ -6,7 +6,8 @@ import torch
 
 from pgae_lite.model.signals import SIGNAL_PROBS, sample_signals
 from pgae_lite.train.config import TrainConfig
-from pgae_lite.train.supervision import PAIRED, UNIMODAL, draw_signals, labelled_samples, restricted
+from pgae_lite.train.supervision import (PAIRED, UNIMODAL, SupervisionConfig, draw_signals, labelled_samples,
+                                         restricted)
 
 
 def test_within_each_kind_a_signal_keeps_its_weight():
@@ -25,7 +26,7 @@ def test_the_recipe_draws_exactly_what_it_drew_before():
 
 @pytest.mark.parametrize("share", [0.02, 0.2, 0.5])
 def test_a_share_of_the_updates_is_paired_whole(share):
-    cfg, gen = TrainConfig(paired_share=share), torch.Generator().manual_seed(0)
+    cfg, gen = TrainConfig(supervision=SupervisionConfig(share)), torch.Generator().manual_seed(0)
     kinds = []
     for _ in range(4000):
         signals = set(draw_signals(16, gen, cfg).tolist())
@@ -39,7 +40,7 @@ def test_a_fixed_share_of_the_samples_is_labelled_and_only_those_are_paired():
     assert labelled.sum().item() == 10 and torch.equal(labelled, labelled_samples(200, 0.05, seed=1))
     assert not torch.equal(labelled, labelled_samples(200, 0.05, seed=2))
     assert labelled_samples(30, 0.02, seed=0).sum().item() == 1                 # never none
-    cfg, gen = TrainConfig(labelled_share=0.05), torch.Generator().manual_seed(0)
+    cfg, gen = TrainConfig(supervision=SupervisionConfig(0.05, of="samples")), torch.Generator().manual_seed(0)
     seen_paired = torch.zeros(200, dtype=torch.bool)
     for _ in range(300):
         index = torch.randperm(200, generator=gen)[:16]
@@ -51,20 +52,21 @@ def test_a_fixed_share_of_the_samples_is_labelled_and_only_those_are_paired():
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"paired_share": 0.0}, "paired_share must be a number > 0 and <= 1"),
-    ({"labelled_share": 1.5}, "labelled_share must be a number > 0 and <= 1"),
-    ({"paired_share": 0.2, "labelled_share": 0.2}, "one reading of limited supervision"),
+    ({"share": 0.0}, r"SupervisionConfig share must be a number in \(0, 1\], the paired share; got 0.0"),
+    ({"share": 1.5, "of": "samples"}, r"SupervisionConfig share must be a number in \(0, 1\]"),
+    ({"share": 0.2, "of": "both"}, "SupervisionConfig of must be one of updates, samples"),
 ])
 def test_a_wrong_share_is_refused(change, message):
+    """One part, one reading of limited supervision (the old paired_share and labelled_share at once: no more)."""
     with pytest.raises(ValueError, match=message):
-        TrainConfig(**change)
+        TrainConfig(supervision=SupervisionConfig(**change))
 
 
 def test_a_training_on_a_labelled_subset_runs_and_is_seeded(toy_short):
     from pgae_lite.config import get_profile
     from pgae_lite.train.loop import train
 
-    prof = get_profile("smoke", epochs=2, labelled_share=0.1)
+    prof = get_profile("smoke", epochs=2, supervision=SupervisionConfig(0.1, of="samples"))
     first = train(toy_short, prof, device="cpu", progress=False)
     second = train(toy_short, prof, device="cpu", progress=False)
     assert first.history == second.history

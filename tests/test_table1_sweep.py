@@ -3,8 +3,9 @@
 The same smoke sweep writes the same result files, digit for digit, in this process, on a local
 cluster of two workers and on two workers started by hand; a worker whose cache holds other
 features (another machine's CAE) fails the sweep with a DataMismatchError, and one whose cache is
-empty makes the data itself and gives the same numbers; two sweeps writing one folder at once
-both finish, and leave the folder as one sweep would.
+empty makes the data itself and gives the same numbers; a sweep on the cluster and a run in one
+process writing one folder at once both finish, and leave the folder as one run would. Every
+sweep runs on the session's one cluster (tests/conftest.py, SharedCluster).
 """
 from __future__ import annotations
 
@@ -44,8 +45,9 @@ def one_process(original_data, tmp_path_factory):
 
 
 @pytest.mark.timeout(300)
-def test_a_local_cluster_writes_the_files_of_one_process(original_data, one_process, tmp_path):
-    reproduce(original_data, out_dir=tmp_path, workers=2, **SMOKE)
+def test_a_local_cluster_writes_the_files_of_one_process(original_data, one_process, tmp_path, dask_cluster):
+    with dask_cluster.on_local():
+        reproduce(original_data, out_dir=tmp_path, scheduler=dask_cluster.address, **SMOKE)
     assert len(list((tmp_path / "logs").glob("table1-*.log"))) == 4      # 2 trainings x 2 seeds
     assert_same(written(tmp_path), one_process)
 
@@ -53,10 +55,9 @@ def test_a_local_cluster_writes_the_files_of_one_process(original_data, one_proc
 @pytest.mark.timeout(300)
 def test_workers_started_by_hand_write_the_files_of_one_process(original_data, one_process, tmp_path,
                                                                dask_cluster):
-    for _ in range(2):
-        dask_cluster.add_worker()
-    dask_cluster.wait_for(2)
-    reproduce(original_data, out_dir=tmp_path, scheduler=dask_cluster.address, **SMOKE)
+    dask_cluster.hand_workers(2)
+    with dask_cluster.on("hand"):
+        reproduce(original_data, out_dir=tmp_path, scheduler=dask_cluster.address, **SMOKE)
     assert_same(written(tmp_path), one_process)
 
 
@@ -67,12 +68,12 @@ def other_machines_cache(folder, profile: str, change) -> None:
 
     from pgae_lite.config import get_profile
     from pgae_lite.data.dataset import PGAEDataset
-    from pgae_lite.runs.pipeline import _stem
+    from pgae_lite.runs.data import cache_stem
     from pgae_lite.util.storage import cache_dir, config_digest
 
     prof = get_profile(profile)
     shutil.copytree(cache_dir(), folder, dirs_exist_ok=True)
-    path = folder / "features" / f"{_stem(prof.data, prof.cae)}.npz"
+    path = folder / "features" / f"{cache_stem(prof.data, prof.cae)}.npz"
     fingerprint = config_digest({"data": prof.data.to_dict(), "cae": prof.cae.to_dict()})
     data = PGAEDataset.load(path, fingerprint=fingerprint)
     data.vision, data.vision_opposite = change(data.vision), change(data.vision_opposite)
@@ -81,15 +82,17 @@ def other_machines_cache(folder, profile: str, change) -> None:
 
 @pytest.mark.timeout(300)
 def test_a_worker_with_another_cae_fails_the_sweep_clearly(smoke_episodes, tmp_path, dask_cluster):
-    from pgae_lite.runs.pipeline import simulated_dataset
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.data import simulated_dataset
     from pgae_lite.train.checkpoint import DataMismatchError
 
-    simulated_dataset("smoke", "cpu", progress=False)           # this machine's data, made here
+    simulated_dataset(get_profile("smoke"), "cpu", progress=False)     # this machine's data, made here
     elsewhere = tmp_path / "elsewhere-cache"
     other_machines_cache(elsewhere, "smoke", lambda v: (v * 1.05).astype(v.dtype))
     dask_cluster.add_worker(PGAE_LITE_CACHE=str(elsewhere))
     dask_cluster.wait_for(1)
-    with pytest.raises(DataMismatchError, match=rf"not trained on this data.*trained on .*{elsewhere.name}"):
+    with pytest.raises(DataMismatchError, match=rf"not trained on this data.*trained on .*{elsewhere.name}"), \
+            dask_cluster.on("own"):                             # the unit runs on that worker
         reproduce(None, out_dir=tmp_path / "out", scheduler=dask_cluster.address,
                   **{**SMOKE, "rows": "PGAE", "seeds": 1})
 
@@ -99,20 +102,24 @@ def test_a_worker_with_an_empty_cache_makes_the_data_itself(smoke_episodes, tmp_
     here = reproduce(None, out_dir=tmp_path / "here", workers=1, **{**SMOKE, "rows": "PGAE", "seeds": 1})
     dask_cluster.add_worker(PGAE_LITE_CACHE=str(tmp_path / "empty-cache"))
     dask_cluster.wait_for(1)
-    there = reproduce(None, out_dir=tmp_path / "there", scheduler=dask_cluster.address,
-                      **{**SMOKE, "rows": "PGAE", "seeds": 1})
+    with dask_cluster.on("own"):                                # the unit runs on that worker
+        there = reproduce(None, out_dir=tmp_path / "there", scheduler=dask_cluster.address,
+                          **{**SMOKE, "rows": "PGAE", "seeds": 1})
     assert (tmp_path / "empty-cache" / "features").is_dir()     # recorded and encoded on the worker
     assert there["rows"] == here["rows"]                        # and the same numbers
 
 
 @pytest.mark.timeout(600)
-def test_two_sweeps_writing_one_folder_at_once_both_finish(original_data, one_process, tmp_path):
+def test_a_sweep_and_a_run_writing_one_folder_at_once_both_finish(original_data, one_process, tmp_path,
+                                                                  dask_cluster):
+    """Two ``reproduce`` commands into one folder at once, one a sweep on the cluster, the other training in its
+    own process: the trainings they share wait for each other, and the folder holds one run's files."""
     out = tmp_path / "shared"
     command = [sys.executable, "-m", "pgae_lite", "reproduce", "--original-data", str(original_data),
                "--profile", "smoke", "--rows", "PGAE,PGAE-opposite", "--seeds", "2", "--out", str(out),
-               "--workers", "2", "--device", "cpu", "--no-progress"]
-    runs = [subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-            for _ in range(2)]
+               "--device", "cpu", "--no-progress"]
+    runs = [subprocess.Popen(command + extra, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            for extra in (["--scheduler", dask_cluster.address], ["--workers", "1"])]
     outputs = [run.communicate(timeout=500)[0] for run in runs]
     assert [run.returncode for run in runs] == [0, 0], outputs
-    assert_same(written(out), one_process)                     # one sweep's files, none half-written
+    assert_same(written(out), one_process)                     # one run's files, none half-written

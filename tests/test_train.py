@@ -12,9 +12,11 @@ import torch
 from pgae_lite.config import PROFILE_ENV, PROFILES, ModelConfig, Profile, TrainConfig, get_profile
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError, load_checkpoint, load_model
-from pgae_lite.train.loss import lr_factor, pgae_loss
+from pgae_lite.model.loss import pgae_loss
+from pgae_lite.runs.pipeline import load_model
+from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError, load_checkpoint
 from pgae_lite.train.loop import train
+from pgae_lite.train.optimiser import lr_factor
 
 
 def tiny_profile(units: int = 16, **train) -> Profile:
@@ -274,7 +276,7 @@ def test_input_noise_changes_training_and_stays_deterministic(toy_short):
 
 
 def test_add_input_noise_separates_vision_and_joints():
-    from pgae_lite.train.loss import add_input_noise
+    from pgae_lite.train.draws import add_input_noise
     x = torch.zeros(4, 100, 35)
     torch.manual_seed(0)
     both = add_input_noise(x, 0.05)
@@ -315,3 +317,31 @@ def test_weight_decay_uses_adamw(toy_short):
     decayed = train(toy_short, tiny_profile(epochs=2, weight_decay=0.1), progress=False, device="cpu")
     assert decayed.history != plain.history
     assert get_profile("paper").train.weight_decay == 0.0
+
+
+# --------------------------------------------------------------------------- one loop for every model
+def test_the_loop_builds_the_model_its_recipe_describes(toy_short):
+    """No model is named: the recipe's parts say which model the loop builds, and every one trains the same way."""
+    from pgae_lite.model.pgae import PGAE
+    from pgae_lite.model.prae import PRAE
+    from pgae_lite.model.ptae import PTAE
+    from pgae_lite.model.pvae import PVAE
+    from pgae_lite.runs.rows import TRAININGS
+
+    base = tiny_profile(epochs=1)
+    built = {name: train(toy_short, TRAININGS[name].profile(base), progress=False, device="cpu")
+             for name in ("PGAE", "PTAE", "PRAE", "PVAE")}
+    assert {name: type(t.model) for name, t in built.items()} == {"PGAE": PGAE, "PTAE": PTAE, "PRAE": PRAE,
+                                                                  "PVAE": PVAE}
+    for name in ("PGAE", "PTAE"):
+        assert set(built[name].history[-1]) == {"epoch", "loss", "language_loss", "action_loss", "lr", "gate"}
+    assert "gate" in built["PGAE"].history[-1] and built["PTAE"].history[-1]["gate"] == {}   # PTAE has no GMU
+    assert set(built["PVAE"].history[-1]) - set(built["PRAE"].history[-1]) == {"kl"}
+    assert all(not t.model.training and t.profile.model == TRAININGS[n].profile(base).model for n, t in built.items())
+    mine = PGAE(ModelConfig(units=8, plan_keyframes=0))                     # a model given: not built
+    assert train(toy_short, base, progress=False, device="cpu", model=mine).model is mine
+
+
+def test_the_loop_takes_a_profile_not_a_name(toy_short):
+    with pytest.raises(TypeError, match="train takes a Profile, e.g. pgae_lite.config.get_profile"):
+        train(toy_short, "smoke", progress=False, device="cpu")

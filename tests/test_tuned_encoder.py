@@ -43,7 +43,7 @@ def test_the_mean_counts_real_tokens_only():
 
 
 def test_only_the_top_layer_trains_and_learns_one_call_in_train_every():
-    from pgae_lite.train.loss import parameter_groups
+    from pgae_lite.train.optimiser import parameter_groups
 
     encoder = TunedPretrainedEncoder().train()
     trained = {name for name, p in encoder.named_parameters() if p.requires_grad}
@@ -56,13 +56,18 @@ def test_only_the_top_layer_trains_and_learns_one_call_in_train_every():
 
 
 def test_the_config_builds_it_for_pretrained_with_tuned_top_layer():
-    from pgae_lite.bert.encoders import build_language_encoder
+    from pgae_lite.bert.config import PretrainedConfig
+    from pgae_lite.bert.pretrained import PretrainedLanguageEncoder
     from pgae_lite.model.config import ModelConfig
+    from pgae_lite.model.pgae import LanguageEncoder, build_language_encoder
 
-    built = build_language_encoder(ModelConfig(language_encoder="pretrained", tuned_top_layer=True))
+    built = build_language_encoder(ModelConfig(language=PretrainedConfig(tuned_top_layer=True)))
     assert isinstance(built, TunedPretrainedEncoder)
-    with pytest.raises(ValueError, match="tuned_top_layer needs a pretrained language encoder"):
-        ModelConfig(language_encoder="lstm", tuned_top_layer=True)
+    frozen = build_language_encoder(ModelConfig(language=PretrainedConfig()))
+    assert isinstance(frozen, PretrainedLanguageEncoder) and not isinstance(frozen, TunedPretrainedEncoder)
+    assert isinstance(build_language_encoder(ModelConfig()), LanguageEncoder)       # no part: the LSTM
+    with pytest.raises(ValueError, match="PretrainedConfig tuned_top_layer must be True or False"):
+        PretrainedConfig(tuned_top_layer="yes")
 
 
 def test_after_stop_learning_the_table_gives_what_the_layer_gives():

@@ -8,17 +8,18 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.bert.encoders import build_pgae
-from pgae_lite.freeform.attention_pooling import AttentivePretrainedEncoder
+from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentivePretrainedEncoder
+from pgae_lite.model.build import build_model
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.world.words import SIGNALS
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.freeform.phrasing_bank import MEANINGS, PhrasingBank
+from pgae_lite.freeform.phrasing_bank import MEANINGS, PhrasingBank, PhrasingsConfig
 from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
 from pgae_lite.model.signals import make_batch
-from pgae_lite.train.checkpoint import load_checkpoint, load_model
-from pgae_lite.train.loss import parameter_groups
+from pgae_lite.runs.pipeline import language_source, load_model
+from pgae_lite.train.checkpoint import load_checkpoint
+from pgae_lite.train.optimiser import parameter_groups
 from pgae_lite.train.loop import train
 from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
 
@@ -31,7 +32,7 @@ TEXTS = ["repeat language could you please shove the crimson block away from you
 
 @pytest.fixture(scope="module")
 def tuned() -> PGAE:
-    return build_pgae(ModelConfig(units=8, hidden=4, language_encoder="pretrained-attention", tuned_top_layer=True))
+    return build_model(ModelConfig(units=8, hidden=4, language=AttentionConfig(tuned_top_layer=True)))
 
 
 def test_the_copy_reproduces_the_transformers_top_layer():
@@ -97,9 +98,10 @@ def test_the_bank_keeps_the_layers_input_and_reads_it_through_the_layer(tuned, t
 
 def test_training_tunes_saves_and_reloads_the_layer(toy_short, tmp_path):
     profile = get_profile("smoke")
-    profile.model = replace(profile.model, language_encoder="pretrained-attention", tuned_top_layer=True)
-    profile.train = replace(profile.train, phrasings=2, phrasing_signals=("repeat language",))
-    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
+    profile.model = replace(profile.model, language=AttentionConfig(tuned_top_layer=True))
+    profile.train = replace(profile.train, phrasings=PhrasingsConfig(per_meaning=2, signals=("repeat language",)))
+    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu",
+                    language=language_source(profile))
     assert np.isfinite(trained.history[-1]["loss"])
     layer = trained.model.language_encoder.top
     start = TunedTopLayer(load_transformer(None))
@@ -115,22 +117,23 @@ def test_training_tunes_saves_and_reloads_the_layer(toy_short, tmp_path):
 def test_resuming_keeps_the_layers_one_step_in_three(toy_short, tmp_path, interrupt_training):
     """Stopped after epoch 2 of 3 and trained again: the same weights, tuned layer included."""
     profile = get_profile("smoke")
-    profile.model = replace(profile.model, language_encoder="pretrained-attention", tuned_top_layer=True)
-    profile.train = replace(profile.train, phrasings=2, phrasing_signals=("repeat language",),
+    profile.model = replace(profile.model, language=AttentionConfig(tuned_top_layer=True))
+    profile.train = replace(profile.train, phrasings=PhrasingsConfig(per_meaning=2, signals=("repeat language",)),
                             batch_size=24)   # 4 steps an epoch: the resumed epoch starts mid-cycle of three
-    whole = train(toy_short, profile, out_dir=tmp_path / "whole", progress=False, device="cpu")
-    interrupt_training(toy_short, profile, tmp_path / "cut", epoch=3)
-    resumed = train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu")
+    language = language_source(profile)
+    whole = train(toy_short, profile, out_dir=tmp_path / "whole", progress=False, device="cpu", language=language)
+    interrupt_training(toy_short, profile, tmp_path / "cut", epoch=3, language=language)
+    resumed = train(toy_short, profile, out_dir=tmp_path / "cut", progress=False, device="cpu", language=language)
     for name, weight in whole.model.state_dict().items():
         other = resumed.model.state_dict()[name]
         assert (torch.equal(weight, other) if torch.is_tensor(weight) else weight == other), name
 
 
 def test_clear_errors_and_the_keys_of_models_before():
-    with pytest.raises(ValueError, match="tuned_top_layer needs a pretrained language encoder"):
-        ModelConfig(tuned_top_layer=True)
-    with pytest.raises(ValueError, match="tuned_top_layer must be True or False; got 'yes'"):
-        ModelConfig(language_encoder="pretrained-attention", tuned_top_layer="yes")
+    with pytest.raises(TypeError, match="tuned_top_layer"):
+        ModelConfig(tuned_top_layer=True)            # no option of the model: a part of a pretrained encoder's
+    with pytest.raises(ValueError, match="AttentionConfig tuned_top_layer must be True or False; got 'yes'"):
+        ModelConfig(language=AttentionConfig(tuned_top_layer="yes"))
     other = SimpleNamespace(name="some/gpt", model=torch.nn.Linear(2, 2))
     with pytest.raises(ValueError, match="needs a BERT-style transformer .* 'some/gpt' is Linear"):
         top_layer(other)

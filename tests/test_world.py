@@ -150,8 +150,11 @@ def test_simulator_builds_and_records_the_new_cube():
 
 # ------------------------------------------------------------------ model and training
 def test_pgae_for_the_larger_vocabulary_trains_and_loads(tmp_path):
-    from pgae_lite.runs.new_colour import load_pgae
+    from pgae_lite.config import with_world
+    from pgae_lite.runs.pipeline import load_model
+    from pgae_lite.train.checkpoint import CHECKPOINT
     from pgae_lite.train.loop import train
+    from pgae_lite.util.storage import CheckpointMismatchError
 
     data = tiny(WORLD, [0, 77, 144, 150, 165, 184])
     assert data.descriptions.max() == 24
@@ -160,11 +163,16 @@ def test_pgae_for_the_larger_vocabulary_trains_and_loads(tmp_path):
     assert model.language_encoder.input_dim == 30
     trained = train(data, profile, out_dir=tmp_path, progress=False, model=model)
     assert trained.model.language_decoder.out.out_features == 25
-    loaded, normaliser, _ = load_pgae(tmp_path, WORLD, device="cpu")
+    loaded, normaliser, _ = load_model(tmp_path / CHECKPOINT, device="cpu", lexicon=WORLD.lexicon)
     assert all(torch.equal(a.cpu(), b) for a, b in
                zip(trained.model.state_dict().values(), loaded.state_dict().values()))
-    with pytest.raises(ValueError, match="23 words"):   # the paper's world
-        load_pgae(tmp_path, DEFAULT_WORLD, device="cpu")
+    with pytest.raises(CheckpointMismatchError, match="do not fit the model"):   # the paper's 23 words
+        load_model(tmp_path / CHECKPOINT, device="cpu")
+    # in the world's profile the one loop builds the model for the world's words itself
+    built = train(data, with_world(profile, WORLD), out_dir=tmp_path / "built", progress=False)
+    assert built.model.lexicon == WORLD.lexicon and built.model.language_decoder.out.out_features == 25
+    again, _, _ = load_model(tmp_path / "built" / CHECKPOINT, device="cpu", lexicon=WORLD.lexicon)
+    assert all(torch.equal(a.cpu(), b) for a, b in zip(built.model.state_dict().values(), again.state_dict().values()))
 
 
 # ------------------------------------------------------------------ the check
