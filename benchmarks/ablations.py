@@ -20,17 +20,17 @@ import copy
 from dataclasses import replace
 
 import torch
-
 from harness import Benchmark, side_by_side
-from pgae_lite.world import words as language
+
 from pgae_lite.config import Profile, get_profile
 from pgae_lite.evaluate.table1 import evaluate
+from pgae_lite.model.layers import ConcatBottleneck
 from pgae_lite.model.pgae import PGAE
+from pgae_lite.runs.data import worker_dataset
 from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import TRAININGS
-from pgae_lite.runs.table1_unit import worker_dataset
-from pgae_lite.model.layers import ConcatBottleneck
 from pgae_lite.train.loop import train
+from pgae_lite.world import words as language
 
 #: ex-pgae-no-both: the signals without "repeat both" (describe, execute, repeat action, -, repeat language)
 NO_BOTH = (3 / 8, 3 / 8, 1 / 8, 0.0, 1 / 8)

@@ -22,9 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from jupyter_cache import get_cache
-
 from harness import Benchmark
+from jupyter_cache import get_cache
 
 bench = Benchmark("book_build", __doc__)
 bench.parser.add_argument("--fresh-cache", action="store_true",

@@ -25,8 +25,8 @@ from dataclasses import replace
 
 import numpy as np
 import torch
-
 from harness import Benchmark
+
 from pgae_lite.cae import (
     ChannelSeparatedCAE,
     extract_features,

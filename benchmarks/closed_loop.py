@@ -26,15 +26,16 @@ import statistics
 import time
 
 import torch
-
 from harness import Benchmark, key_value, side_by_side
-from pgae_lite.robot.closedloop import compare, success_summary
+
 from pgae_lite.config import Profile, get_profile
+from pgae_lite.evaluate.table1 import evaluate
+from pgae_lite.model.plan import which_cube_probe
+from pgae_lite.robot.closedloop import compare, success_summary
+from pgae_lite.runs.data import simulated_dataset, trained_cae
+from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import training_named
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.evaluate.table1 import evaluate
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model
-from pgae_lite.model.plan import which_cube_probe
 
 _LOADED: dict = {}      # (data, CAE settings) -> (CAE, dataset), in this process
 

@@ -15,8 +15,8 @@ from __future__ import annotations
 import time
 
 import torch
-
 from harness import Benchmark
+
 from pgae_lite.config import get_profile
 from pgae_lite.data.original import load_original
 from pgae_lite.train.loop import train

@@ -22,6 +22,7 @@ import time
 from dataclasses import fields, replace
 
 from harness import Benchmark, key_value
+
 from pgae_lite.config import Profile, get_profile
 from pgae_lite.data.original import load_original
 from pgae_lite.model.config import PARTS, ModelConfig

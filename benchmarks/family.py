@@ -36,9 +36,10 @@ def run(row: str, seed: int, profile: Profile, original_data: str | None, models
     from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.model.build import build_model
     from pgae_lite.model.pgae import count_parameters
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.pipeline import unit_profile
     from pgae_lite.runs.rows import ROWS as BOOK_ROWS
-    from pgae_lite.runs.table1_unit import table1_unit, worker_dataset
+    from pgae_lite.runs.table1_unit import table1_unit
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)                  # one core per worker

@@ -32,18 +32,19 @@ import time
 
 import numpy as np
 import torch
-
 from free_language import training_words, words
 from harness import Benchmark, side_by_side
-from pgae_lite.freeform.paraphrases import load_paraphrases
-from pgae_lite.bert.pretrained import input_text
+
 from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.bert.pretrained import input_text
 from pgae_lite.config import Profile, get_profile
 from pgae_lite.evaluate.table1 import predict
 from pgae_lite.freeform.attention_pooling import AttentionConfig
+from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model
+from pgae_lite.runs.data import simulated_dataset, trained_cae
+from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import TRAININGS, Training
 
 PHRASINGS_HELD_OUT = TRAININGS["PGAE-BERT-phrasings-held-out"]

@@ -52,21 +52,22 @@ from pathlib import Path
 
 import numpy as np
 import torch
-
 from harness import Benchmark, side_by_side
-from pgae_lite.robot.closedloop import variation_of
+
+from pgae_lite.bert.pretrained import input_text, load_transformer
 from pgae_lite.config import Profile, get_profile
-from pgae_lite.runs.rows import training_named
-from pgae_lite.evaluate.table1 import evaluate, predict
-from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
-from pgae_lite.world.words import SIGNALS, VOCABULARY
 from pgae_lite.data.original import load_original
+from pgae_lite.evaluate.table1 import evaluate, predict
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import training_lexicon
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model, unit_profile
-from pgae_lite.bert.pretrained import input_text, load_transformer
+from pgae_lite.robot.closedloop import variation_of
+from pgae_lite.robot.instructions import ROUTES, execute_paraphrases, paraphrase_of
+from pgae_lite.runs.data import simulated_dataset, trained_cae
+from pgae_lite.runs.pipeline import trained_model, unit_profile
+from pgae_lite.runs.rows import training_named
 from pgae_lite.train.loop import train
 from pgae_lite.util.storage import CACHE_ENV
+from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 
 def words(text: str) -> set[str]:

@@ -13,7 +13,7 @@
         main()
 
 The work runs under the ``__main__`` guard: recording the simulated data
-(:func:`pgae_lite.sim.dataset.generate`, which :func:`pgae_lite.runs.pipeline.simulated_dataset`
+(:func:`pgae_lite.sim.dataset.generate`, which :func:`pgae_lite.runs.data.simulated_dataset`
 and ``trained_cae`` call when the cache lacks it) and a sweep's local cluster
 (:func:`side_by_side`) spawn worker processes, and each re-imports the script;
 unguarded, they would run the benchmark again.
@@ -120,7 +120,7 @@ class Benchmark:
 
     def parse(self, argv: list[str] | None = None) -> argparse.Namespace:
         self.args = self.parser.parse_args(argv)
-        from pgae_lite.config import profile_name   # here, not at the top: --help stays fast
+        from pgae_lite.config import profile_name  # here, not at the top: --help stays fast
         from pgae_lite.util.errors import ArgumentError
 
         try:      # the name given, else $PGAE_LITE_PROFILE's, else book (checked: an unknown name fails here)
@@ -144,7 +144,7 @@ class Benchmark:
 
     def write(self, data: dict, **fields) -> Path:
         """``data`` with the command, commit, date and machine, to :attr:`path` (atomically)."""
-        from pgae_lite.util.storage import atomic_write_text     # here: torch loads only when a result is written
+        from pgae_lite.util.storage import atomic_write_text  # here: torch loads only when a result is written
 
         args = self.args or argparse.Namespace(profile=None, seeds=None, threads=None)
         report = {"benchmark": self.name,
@@ -169,6 +169,6 @@ def side_by_side(work, jobs: list[tuple], workers: int) -> list:
     ``work`` must be a module-level function of the benchmark (the workers receive it pickled) and
     should set its own threads (one per worker: these networks gain nothing from two).
     """
-    from pgae_lite.runs.sweep import run_sweep     # here: dask loads only when a sweep runs
+    from pgae_lite.runs.sweep import run_sweep  # here: dask loads only when a sweep runs
 
     return run_sweep(work, jobs, workers=max(1, workers))

@@ -25,9 +25,9 @@ def run(model: str, seed: int, profile: Profile, original: str, models: str) -> 
 
     from pgae_lite.config import get_profile
     from pgae_lite.evaluate.incongruent import incongruent_cells
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.pipeline import train_when_free, unit_profile
     from pgae_lite.runs.rows import TRAININGS
-    from pgae_lite.runs.table1_unit import worker_dataset
 
     torch.set_num_threads(1)
     profile = get_profile(profile, seed=seed)

@@ -42,8 +42,8 @@ def run(model: str, reading: str, share: float, seed: int, profile: Profile, ori
 
     from pgae_lite.config import get_profile
     from pgae_lite.evaluate.table1 import evaluate
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.pipeline import train_when_free, unit_profile
-    from pgae_lite.runs.table1_unit import worker_dataset
 
     torch.set_num_threads(1)
     profile = get_profile(profile, seed=seed)

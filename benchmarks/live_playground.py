@@ -145,7 +145,8 @@ def parity(site: str, browser, name: str, manifest: dict, per_kind: int, profile
     from refusals import CLASSES, sentence
 
     from pgae_lite.freeform.refusals import refusal
-    from pgae_lite.runs.pipeline import simulated_dataset, trained_model
+    from pgae_lite.runs.data import simulated_dataset
+    from pgae_lite.runs.pipeline import trained_model
     from pgae_lite.web.sentence import free_text_reference
 
     assert manifest["profile"] == profile.name, (manifest["profile"], profile.name)

@@ -68,6 +68,7 @@ def main() -> None:
     from pgae_lite.config import get_profile, with_world
     from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.exercises import check_new_colour
+    from pgae_lite.runs import data as data_pipeline
     from pgae_lite.runs import pipeline
     from pgae_lite.runs.rows import TRAININGS
     from pgae_lite.sim.dataset import generate
@@ -76,7 +77,7 @@ def main() -> None:
     overrides = {"epochs": args.epochs} if args.epochs else {}
     coloured = with_world(get_profile(args.profile, **overrides), world)     # resolved once, here
     seed, training = args.seeds[0], TRAININGS["PGAE"]
-    cae = pipeline.cae_path(coloured.data, coloured.cae)
+    cae = data_pipeline.cae_path(coloured.data, coloured.cae)
     # PGAE's recipe with the seed (unit_profile's, without the data: PGAE's authors count no iterations)
     folder = pipeline.model_folder(training.profile(get_profile(coloured, seed=seed)), training.name)
     cached = {"cae": cae.exists(),                      # True: the step only loads
@@ -87,10 +88,10 @@ def main() -> None:
     report = generate(coloured.data.parts()[-1], progress=False)
     seconds["record"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
-    pipeline.trained_cae(coloured, progress=False)
+    data_pipeline.trained_cae(coloured, progress=False)
     seconds["cae"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
-    data = pipeline.simulated_dataset(coloured, progress=False)
+    data = data_pipeline.simulated_dataset(coloured, progress=False)
     seconds["features"] = round(time.perf_counter() - t, 1)
     t = time.perf_counter()
     trained = pipeline.trained_model(training, coloured, seed, progress=False)

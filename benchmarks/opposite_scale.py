@@ -28,13 +28,14 @@ from __future__ import annotations
 from pathlib import Path
 
 import torch
-
 from harness import Benchmark, side_by_side
+
 from pgae_lite.config import Profile, get_profile
 from pgae_lite.data.normaliser import Normaliser, spread_of
 from pgae_lite.data.original import load_original
 from pgae_lite.evaluate.table1 import evaluate, predict
-from pgae_lite.runs.pipeline import simulated_dataset, trained_model, unit_profile
+from pgae_lite.runs.data import simulated_dataset
+from pgae_lite.runs.pipeline import trained_model, unit_profile
 from pgae_lite.runs.rows import TRAININGS, Training
 from pgae_lite.train.loop import train
 

@@ -30,9 +30,9 @@ def run(row: str, epochs: int, profile: Profile, original_data: str) -> dict:
 
     from pgae_lite.config import get_profile
     from pgae_lite.model.pgae import count_parameters
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.pipeline import unit_profile
     from pgae_lite.runs.rows import ROWS as BOOK_ROWS
-    from pgae_lite.runs.table1_unit import worker_dataset
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)                  # one core per worker

@@ -28,15 +28,15 @@ import math
 import time
 
 import torch
+from harness import Benchmark
 from torch.profiler import ProfilerActivity, profile
 
-from harness import Benchmark
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
-from pgae_lite.world.words import INPUT_DIM, VOCABULARY
 from pgae_lite.data.original import load_original
 from pgae_lite.model.signals import ACTION_IN, LANG_IN, SIGNAL_PROBS
 from pgae_lite.train.loop import train
+from pgae_lite.world.words import INPUT_DIM, VOCABULARY
 
 bench = Benchmark("profile_epoch", __doc__)
 bench.add_original_data()

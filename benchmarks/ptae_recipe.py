@@ -11,7 +11,6 @@ compare. Writes results/ptae_recipe.json.
 from __future__ import annotations
 
 from dataclasses import replace
-
 from typing import TYPE_CHECKING
 
 from harness import Benchmark, side_by_side
@@ -43,8 +42,8 @@ def run(variant: str, seed: int, profile: Profile, original: str) -> dict:
     from pgae_lite.config import get_profile
     from pgae_lite.evaluate.table1 import evaluate
     from pgae_lite.model.pgae import count_parameters
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.rows import TRAININGS
-    from pgae_lite.runs.table1_unit import worker_dataset
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)

@@ -13,13 +13,13 @@ results/recipe_time.json.
 from __future__ import annotations
 
 import time
-
 from dataclasses import replace
 
 from harness import Benchmark
+
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.data.original import load_original
+from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.train.loop import train
 
 #: The recipe before (1,200 epochs, at f994b81): what it changes in today's book recipe, its training and model

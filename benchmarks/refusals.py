@@ -25,12 +25,13 @@ import random
 
 from harness import Benchmark
 
+from pgae_lite.config import get_profile
 from pgae_lite.freeform.paraphrases import load_paraphrases
+from pgae_lite.freeform.refusals import refusal
 from pgae_lite.robot.closedloop import variation_of
 from pgae_lite.robot.instructions import paraphrase_of, say_back, scene_of
-from pgae_lite.freeform.refusals import refusal
-from pgae_lite.config import get_profile
-from pgae_lite.runs.pipeline import simulated_dataset, trained_model
+from pgae_lite.runs.data import simulated_dataset
+from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import training_named
 from pgae_lite.util.errors import ArgumentError
 from pgae_lite.world.patterns import ARRANGEMENTS, pattern_parts

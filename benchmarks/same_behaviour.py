@@ -35,7 +35,6 @@ from pathlib import Path
 
 import numpy as np
 import torch
-
 from harness import ROOT, Benchmark
 
 EVERY_ROW = "PGAE,PGAE-BERT,PGAE-self,PGAE-opposite,PRAE,PVAE,PVAE-BERT,PVAE-BERT-tuned,PTAE"

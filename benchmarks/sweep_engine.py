@@ -36,7 +36,6 @@ from multiprocessing import get_context
 from pathlib import Path
 
 import numpy as np
-
 from harness import ROOT, Benchmark
 
 

@@ -15,13 +15,13 @@ import json
 import statistics
 from pathlib import Path
 
+from harness import Benchmark
+
 from pgae_lite.config import get_profile
 from pgae_lite.evaluate.table1 import PAPER_TABLE
-from pgae_lite.world.words import TEST_SIGNALS
 from pgae_lite.runs.reproduce import parse_rows, run_table1
 from pgae_lite.runs.rows import ROWS
-
-from harness import Benchmark
+from pgae_lite.world.words import TEST_SIGNALS
 
 
 def main() -> None:
@@ -37,7 +37,7 @@ def main() -> None:
     rows = parse_rows(args.rows)
     profile = get_profile(args.profile)
     if args.sim:
-        from pgae_lite.runs.pipeline import simulated_dataset
+        from pgae_lite.runs.data import simulated_dataset
         dataset = simulated_dataset(profile, "cpu", progress=False)
     else:
         from pgae_lite.data.original import load_original

@@ -25,8 +25,8 @@ def run(scale: float, seed: int, profile: Profile) -> dict:
     from pgae_lite.bert import tuned_encoder
     from pgae_lite.config import get_profile
     from pgae_lite.evaluate.table1 import evaluate
+    from pgae_lite.runs.data import worker_dataset
     from pgae_lite.runs.rows import TRAININGS
-    from pgae_lite.runs.table1_unit import worker_dataset
     from pgae_lite.train.loop import train
 
     torch.set_num_threads(1)                  # one core per worker

@@ -6,7 +6,7 @@ Fits a multinomial logistic regression (one linear layer, L-BFGS) from the 30
 visual features of an episode's first frame to the colour of the left cube,
 and another to the colour of the right cube, on the training split; reports
 accuracy on the test split, for NICO's own view and for the opposite view.
-Uses the cached dataset (``pgae_lite.runs.pipeline.simulated_dataset``). Appends a
+Uses the cached dataset (``pgae_lite.runs.data.simulated_dataset``). Appends a
 JSON line to ``experiments/out/cae_probe.jsonl``.
 """
 import argparse
@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from pgae_lite.world.words import COLOURS
 from pgae_lite.config import get_profile
-from pgae_lite.runs.pipeline import simulated_dataset
+from pgae_lite.runs.data import simulated_dataset
+from pgae_lite.world.words import COLOURS
 
 
 def probe(x_train: np.ndarray, y_train: np.ndarray, x_test: np.ndarray, y_test: np.ndarray) -> float:

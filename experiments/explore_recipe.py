@@ -9,15 +9,15 @@ for the two-view model (``--set opposite_prob=0.5``).
 import argparse
 import json
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import torch
-from dataclasses import replace
 
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.data.original import load_original
-from pgae_lite.runs.pipeline import simulated_dataset
+from pgae_lite.evaluate.table1 import evaluate
+from pgae_lite.runs.data import simulated_dataset
 from pgae_lite.train.loop import train
 
 

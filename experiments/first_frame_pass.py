@@ -79,7 +79,8 @@ def main() -> None:
     if "--sim" in rest and "--save" in rest:
         from pgae_lite.config import get_profile
         from pgae_lite.robot.closedloop import compare, success_summary
-        from pgae_lite.runs.pipeline import load_model, simulated_dataset, trained_cae
+        from pgae_lite.runs.data import simulated_dataset, trained_cae
+        from pgae_lite.runs.pipeline import load_model
         profile = get_profile("book")                                     # resolved once, here
         data = simulated_dataset(profile, progress=False)
         cae, _ = trained_cae(profile, progress=False)

@@ -20,10 +20,10 @@ is read only to leave them out.
 import argparse
 from collections import Counter
 
-from pgae_lite.world.words import VOCABULARY
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
 from pgae_lite.freeform.word_lookup import WordLookup
+from pgae_lite.world.words import VOCABULARY
 
 argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()   # no options: --help only
 test_words = {w for p in load_paraphrases() for w in words_of(p.text)}

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import torch
 
-from pgae_lite.world.words import VOCABULARY, parse_description
-from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
+from pgae_lite.freeform.paraphrases import load_paraphrases
+from pgae_lite.world.words import VOCABULARY, parse_description
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
 ap.add_argument("--model", default=None, help="Hugging Face name or folder (default: the shipped all-MiniLM-L6-v2)")

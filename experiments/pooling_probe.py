@@ -16,10 +16,10 @@ import itertools
 
 import torch
 
-from pgae_lite.freeform.attention_pooling import AttentionPooling, padded_token_vectors
-from pgae_lite.world.words import SLOTS
-from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import input_text, load_transformer
+from pgae_lite.freeform.attention_pooling import AttentionPooling, padded_token_vectors
+from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.world.words import SLOTS
 
 parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("--per-meaning", type=int, default=60)

@@ -17,10 +17,11 @@ import numpy as np
 import torch
 
 from pgae_lite.cae import extract_features
-from pgae_lite.robot.closedloop import _drive, _start, execute_batch, spread, variation_of
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import description_text
-from pgae_lite.runs.pipeline import load_model, simulated_dataset, trained_cae
+from pgae_lite.robot.closedloop import _drive, _start, execute_batch, spread, variation_of
+from pgae_lite.runs.data import simulated_dataset, trained_cae
+from pgae_lite.runs.pipeline import load_model
 from pgae_lite.sim.record import shared_simulation
 
 PROFILE = get_profile("book")          # resolved once, here

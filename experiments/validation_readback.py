@@ -28,21 +28,22 @@ from dataclasses import fields, replace
 
 import numpy as np
 import torch
+from second_grammar import second_phrasings
 
+from pgae_lite.bert.pretrained import input_text
+from pgae_lite.config import get_profile
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.world.words import LanguageError, parse_description
-from pgae_lite.world.patterns import Pattern
+from pgae_lite.freeform.paraphrases import Paraphrase
 from pgae_lite.freeform.phrase_lexicon import held_out_words, words_of
 from pgae_lite.freeform.phrasings import phrasings
-from pgae_lite.config import get_profile
-from pgae_lite.runs.rows import Training, training_named
 from pgae_lite.robot.instructions import ROUTES, execute_paraphrases
-from pgae_lite.freeform.paraphrases import Paraphrase
-from pgae_lite.runs.pipeline import simulated_dataset, trained_cae, trained_model
+from pgae_lite.runs.data import simulated_dataset, trained_cae
+from pgae_lite.runs.pipeline import trained_model
+from pgae_lite.runs.rows import Training, training_named
 from pgae_lite.train.config import TrainConfig
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.bert.pretrained import input_text
-from second_grammar import second_phrasings
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import LanguageError, parse_description
 
 
 def parse(text: str) -> tuple[str, ...] | None:

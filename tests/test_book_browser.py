@@ -38,7 +38,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -5,16 +5,24 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.robot.closedloop import (animate, closed_loop, compare, execute_batch, open_loop, pattern_for,
-                                  success_summary, words_of)
 from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_number
 from pgae_lite.model.pgae import ActionDecoder
+from pgae_lite.robot.closedloop import (
+    animate,
+    closed_loop,
+    compare,
+    execute_batch,
+    open_loop,
+    pattern_for,
+    success_summary,
+    words_of,
+)
 from pgae_lite.runs.data import simulated_dataset, trained_cae
 from pgae_lite.sim import Execution, Simulation, execute_trajectory
 from pgae_lite.sim.dataset import load_episode
 from pgae_lite.train.loop import train
+from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_number
 
 SMOKE = get_profile("smoke").data
 PATTERN = 116   # slide the left cube (cyan) fast: a test pattern of the smoke set, 50 steps

@@ -271,9 +271,9 @@ def test_parts_refuse_what_cannot_go_with_their_recipe():
             ModelConfig(hidden=128, crossmodal=CrossmodalConfig(), language=language)
     with pytest.raises(ValueError, match="one bottleneck"):
         ModelConfig(hidden=128, plan_keyframes=0, crossmodal=CrossmodalConfig(), binding=BindingConfig())
-    with pytest.raises(ValueError, match="ModelConfig language must be None or a part's settings"):
+    with pytest.raises(ValueError, match="ModelConfig language must be None or the settings of its"):
         ModelConfig(language="pretrained")                                   # the old spelling
-    with pytest.raises(ValueError, match="TrainConfig supervision must be None or a part's settings"):
+    with pytest.raises(ValueError, match="TrainConfig supervision must be None or the settings of its"):
         TrainConfig(supervision=0.2)
     for share in (0, 0.0, -0.5, 1.5, True, "half"):
         with pytest.raises(ValueError, match="SupervisionConfig share must be a number in \\(0, 1\\]"):

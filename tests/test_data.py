@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.data.normaliser import Normaliser, whitening
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser, whitening
 from pgae_lite.world.patterns import MAX_STEPS, Pattern
 
 

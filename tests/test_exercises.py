@@ -8,13 +8,23 @@ import pytest
 import torch
 from torch import nn
 
-from pgae_lite.model.layers import ConcatBottleneck   # the reference answer of the concatenation exercise
 from pgae_lite.config import get_profile
-from pgae_lite.exercises import (CheckResult, check_bottleneck, check_colour, check_gmu, check_lstm_step,
-                                 check_peephole_step, check_signal_probs, check_vocabulary)
-from pgae_lite.world.words import VOCABULARY
-from pgae_lite.model.layers import GatedMultimodalUnit
+from pgae_lite.exercises import (
+    CheckResult,
+    check_bottleneck,
+    check_colour,
+    check_gmu,
+    check_lstm_step,
+    check_peephole_step,
+    check_signal_probs,
+    check_vocabulary,
+)
+from pgae_lite.model.layers import (
+    ConcatBottleneck,  # the reference answer of the concatenation exercise
+    GatedMultimodalUnit,
+)
 from pgae_lite.train.loop import train
+from pgae_lite.world.words import VOCABULARY
 
 
 def failed_with(result: CheckResult, *phrases: str) -> bool:

@@ -196,7 +196,7 @@ def test_the_evaluation_writes_na_exactly_where_a_model_has_no_path(toy_short):
     from pgae_lite.evaluate.table1 import evaluate, format_table
     from pgae_lite.model.pgae import PGAE
     from pgae_lite.model.prae import PRAE
-    from pgae_lite.model.ptae import CrossmodalConfig, PTAE
+    from pgae_lite.model.ptae import PTAE, CrossmodalConfig
     from pgae_lite.model.pvae import PVAE
     from pgae_lite.world.words import TEST_SIGNALS
 

@@ -19,26 +19,41 @@ import pytest
 import torch
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_cli import run as run_cli
 
 import pgae_lite
-from pgae_lite.config import PROFILE_ENV, get_profile, profile_name
-from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.util.errors import ArgumentError, ArgumentTypeError, PGAELiteError
-from pgae_lite.evaluate.table1 import Predictions, evaluate, format_table, nrmse, predict
-from pgae_lite.config import ModelConfig
-from pgae_lite.robot.instructions import instruction_features
-from pgae_lite.world.words import (BOS_EOS, SLOTS, SYNONYMS, VOCABULARY, LanguageError,
-                                decode, encode, one_hot, parse_description)
-from pgae_lite.model.pgae import PGAE
-from pgae_lite.runs.data import simulated_dataset
-from pgae_lite.robot.playground import (PlayResult, Playground, action_label,
-                                  arrangement_label, find_episode, pattern_number, play,
-                                  simulator_config)
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder, load_transformer
-from pgae_lite.world.patterns import ARRANGEMENTS
-from pgae_lite.runs.reproduce import reproduce, write_results
+from pgae_lite.config import PROFILE_ENV, ModelConfig, get_profile, profile_name
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.evaluate.table1 import Predictions, evaluate, format_table, nrmse, predict
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.robot.instructions import instruction_features
+from pgae_lite.robot.playground import (
+    Playground,
+    PlayResult,
+    action_label,
+    arrangement_label,
+    find_episode,
+    play,
+    scene_pattern,
+    simulator_config,
+)
 from pgae_lite.robot.playground_checks import LAST_PATTERN
-from test_cli import run as run_cli
+from pgae_lite.runs.data import simulated_dataset
+from pgae_lite.runs.reproduce import reproduce, write_results
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError, PGAELiteError
+from pgae_lite.world.patterns import ARRANGEMENTS
+from pgae_lite.world.words import (
+    BOS_EOS,
+    SLOTS,
+    SYNONYMS,
+    VOCABULARY,
+    LanguageError,
+    decode,
+    encode,
+    one_hot,
+    parse_description,
+)
 
 WORDS = [w for w in VOCABULARY if w != BOS_EOS]
 ARRANGEMENT, ACTION = 7, 8          # cyan left, yellow right; slide the left cube fast
@@ -347,7 +362,7 @@ def test_every_public_playground_function_checks_its_arguments(tiny, toy):
     checks = [
         (lambda: arrangement_label(-1), ArgumentError, "arrangement .* got -1"),
         (lambda: action_label(12), ArgumentError, "action .* 0 to 11; got 12"),
-        (lambda: pattern_number(0, 2.0), ArgumentTypeError, "action must be a whole"),
+        (lambda: scene_pattern(0, 2.0), ArgumentTypeError, "action must be a whole"),
         (lambda: find_episode(toy, LAST_PATTERN + 1), ArgumentError,
          f"pattern .* 0 to {LAST_PATTERN}; got {LAST_PATTERN + 1}"),
         (lambda: simulator_config("data"), ArgumentTypeError, "data must be a PGAE"),

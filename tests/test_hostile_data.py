@@ -32,12 +32,12 @@ from pgae_lite.cae import load_cae
 from pgae_lite.config import TrainConfig, get_profile
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.data.original import load_original
-from pgae_lite.sim.dataset import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.runs import data as run_data
 from pgae_lite.runs import pipeline
 from pgae_lite.runs.pipeline import load_model
 from pgae_lite.runs.rows import TRAININGS
+from pgae_lite.sim.dataset import CorruptEpisodeError, episode_folder, generate, load_episode_file
 from pgae_lite.train.checkpoint import CHECKPOINT, load_checkpoint
 from pgae_lite.train.loop import NonFiniteLossError, train
 from pgae_lite.util.storage import (

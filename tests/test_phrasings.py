@@ -8,11 +8,11 @@ from dataclasses import replace
 
 import pytest
 
-from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
-from pgae_lite.world.words import SYNONYMS, VOCABULARY
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import LEXICON, MEANINGS, SLOTS, held_out_words, words_of
 from pgae_lite.freeform.phrasings import gerund, phrasing, phrasings, slot_meanings
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
+from pgae_lite.world.words import SYNONYMS, VOCABULARY
 
 ALL_MEANINGS = list(itertools.product(*(MEANINGS[slot] for slot in SLOTS)))
 

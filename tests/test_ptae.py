@@ -107,9 +107,9 @@ def test_ptae_trains_in_pgaes_loop_learns_and_loads_from_its_checkpoint(toy_shor
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"crossmodal": "attention"}, "ModelConfig crossmodal must be None or a part's settings"),
+    ({"crossmodal": "attention"}, "ModelConfig crossmodal must be None or the settings of its"),
     ({"hidden": 30}, "hidden must be a multiple of heads"),
-    ({"language": "pretrained"}, "ModelConfig language must be None or a part's settings"),
+    ({"language": "pretrained"}, "ModelConfig language must be None or the settings of its"),
     ({"crossmodal": {"dropout": 1.0}}, r"CrossmodalConfig dropout must be a number in \[0, 1\)"),
     ({"crossmodal": {"heads": 0}}, "CrossmodalConfig heads must be a whole number >= 1"),
 ])

@@ -12,15 +12,15 @@ import itertools
 
 import pytest
 
+from pgae_lite.config import get_profile
 from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import training_lexicon
 from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.freeform.refusals import CannotDo, check_instruction, disagreement, refusal
 from pgae_lite.freeform.word_lookup import WordLookup
-from pgae_lite.config import get_profile
 from pgae_lite.robot.closedloop import closed_loop
 from pgae_lite.robot.instructions import execute_paraphrases
 from pgae_lite.robot.playground import play
-from pgae_lite.freeform.refusals import CannotDo, check_instruction, disagreement, refusal
 from pgae_lite.world.patterns import ARRANGEMENTS, Pattern
 from pgae_lite.world.words import COLOURS, LanguageError
 

@@ -6,8 +6,7 @@ import torch
 
 from pgae_lite.model.signals import SIGNAL_PROBS, sample_signals
 from pgae_lite.train.config import TrainConfig
-from pgae_lite.train.supervision import (PAIRED, UNIMODAL, SupervisionConfig, draw_signals, labelled_samples,
-                                         restricted)
+from pgae_lite.train.supervision import PAIRED, UNIMODAL, SupervisionConfig, draw_signals, labelled_samples, restricted
 
 
 def test_within_each_kind_a_signal_keeps_its_weight():

@@ -177,8 +177,8 @@ def test_load_checkpoint_is_weights_only(tmp_path):
 
 # --------------------------------------------------------------------------- loss
 def test_pgae_loss_by_hand(toy_tensors):
-    from pgae_lite.world.words import word_weights
     from pgae_lite.model.signals import make_batch, signal_ids
+    from pgae_lite.world.words import word_weights
     b = make_batch(toy_tensors, torch.tensor([72, 0]), signal_ids(["describe", "execute"]), torch.tensor([0, 0]))
     torch.manual_seed(0)
     out = {"logits": torch.randn(2, 4, 23), "joints": torch.randn(2, 99, 5)}

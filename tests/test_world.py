@@ -9,12 +9,12 @@ import pytest
 import torch
 
 from pgae_lite.config import ModelConfig, get_profile
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import from_recordings
-from pgae_lite.sim.dataset import GENERATOR_VERSION, DatasetConfig
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import Predictions
 from pgae_lite.exercises import check_new_colour
 from pgae_lite.model.pgae import PGAE
+from pgae_lite.sim.dataset import GENERATOR_VERSION, DatasetConfig
 from pgae_lite.util.storage import config_digest
 from pgae_lite.world import words as L
 from pgae_lite.world.colours import DEFAULT_WORLD, World, with_colour

@@ -40,6 +40,7 @@ class PretrainedConfig(Part):
     ``tuned_top_layer`` its top layer tuned on every input (see the module)."""
 
     kind: ClassVar[str] = "pretrained"
+    slot: ClassVar[str] = "language"
     model: str | None = None
     tuned_top_layer: bool = False
 

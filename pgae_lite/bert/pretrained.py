@@ -38,8 +38,16 @@ from pgae_lite.model.language import LanguageEncoderBase
 from pgae_lite.model.signals import EOS, LANG_IN, SIGNAL_TOKEN
 from pgae_lite.util.checks import shown
 from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
-from pgae_lite.world.words import (INPUT_DIM, SIGNALS, SLOTS, SYNONYMS, VOCABULARY, WORD_INDEX, LanguageError,
-                                   normalise_signal)
+from pgae_lite.world.words import (
+    INPUT_DIM,
+    SIGNALS,
+    SLOTS,
+    SYNONYMS,
+    VOCABULARY,
+    WORD_INDEX,
+    LanguageError,
+    normalise_signal,
+)
 
 POOLINGS = ("mean", "cls")
 CACHE_FORMAT = 1          # bump when the texts or the file layout change: old files are recomputed

@@ -16,8 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from pgae_lite.data.checks import (JOINT_BOUNDS, VISION_LIMIT, check_one_hot, check_range, check_vocabulary,
-                                   read_rows, text_of)
+from pgae_lite.data.checks import (
+    JOINT_BOUNDS,
+    VISION_LIMIT,
+    check_one_hot,
+    check_range,
+    check_vocabulary,
+    read_rows,
+    text_of,
+)
 from pgae_lite.data.dataset import DataFormatError, PGAEDataset
 from pgae_lite.world.patterns import MAX_STEPS, Pattern
 from pgae_lite.world.words import COLOURS, VOCABULARY

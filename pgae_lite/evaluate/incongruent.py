@@ -26,12 +26,24 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.signals import SIGNAL_TOKEN, make_batch, signal_ids
 from pgae_lite.world.patterns import pattern_number, pattern_parts
-from pgae_lite.world.words import (ACTIONS, CANONICAL, DEFAULT_LEXICON, DESCRIPTIONS, SIGNALS, SLOTS, SYNONYMS,
-                                   VOCABULARY, WORD_INDEX, decode, equivalent_descriptions, is_correct)
+from pgae_lite.world.words import (
+    ACTIONS,
+    CANONICAL,
+    DEFAULT_LEXICON,
+    DESCRIPTIONS,
+    SIGNALS,
+    SLOTS,
+    SYNONYMS,
+    VOCABULARY,
+    WORD_INDEX,
+    decode,
+    equivalent_descriptions,
+    is_correct,
+)
 
 LANGUAGE_CONFLICTS = ("action", "colour", "speed")      # which word of the description is swapped
 ACTION_CONFLICTS = ("action", "position", "speed")      # what differs in the recording shown

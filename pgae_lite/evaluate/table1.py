@@ -25,13 +25,20 @@ from dataclasses import dataclass
 import numpy as np
 import torch
 
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.signals import LANG_OUT, make_batch, signal_ids
 from pgae_lite.util.checks import instance_of, positive_number, whole_number
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.world.words import (DEFAULT_LEXICON, DESCRIPTIONS, SIGNALS, TEST_SIGNALS, decode, is_correct,
-                                   normalise_signal)
+from pgae_lite.world.words import (
+    DEFAULT_LEXICON,
+    DESCRIPTIONS,
+    SIGNALS,
+    TEST_SIGNALS,
+    decode,
+    is_correct,
+    normalise_signal,
+)
 
 #: The paper's Table 1: (accuracy %, nRMSE %) per row and signal.
 PAPER_TABLE: dict[str, dict[str, tuple[float, float]]] = {

@@ -17,8 +17,13 @@ Sec. 4: the vocabulary, and our simulator's cube colours; Sec. 2: the binding lo
 Every check is importable from here, e.g. ``from pgae_lite.exercises import check_gmu``.
 """
 from pgae_lite.exercises.family import check_binding_loss
-from pgae_lite.exercises.model import (check_bottleneck, check_gmu, check_lstm_step, check_peephole_step,
-                                      check_signal_probs)
+from pgae_lite.exercises.model import (
+                                      check_bottleneck,
+                                      check_gmu,
+                                      check_lstm_step,
+                                      check_peephole_step,
+                                      check_signal_probs,
+)
 from pgae_lite.exercises.result import CheckResult
 from pgae_lite.exercises.world import check_colour, check_new_colour, check_vocabulary
 

@@ -19,17 +19,28 @@ from typing import Callable, Sequence
 import torch
 from torch import nn
 
-from pgae_lite.model.config import ModelConfig
 from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.world.words import DESCRIPTIONS, SIGNALS, word_weights
+from pgae_lite.data.toy import toy_dataset
+from pgae_lite.exercises.result import (
+    RAISED,
+    CheckResult,
+    _build,
+    _call,
+    _compare,
+    _diagnose,
+    _numbers,
+    _pair,
+    _shape,
+    _unchanged,
+    _value_problem,
+)
+from pgae_lite.model.config import ModelConfig
 from pgae_lite.model.layers import GatedMultimodalUnit, PeepholeLSTMCell
+from pgae_lite.model.loss import pgae_loss
 from pgae_lite.model.pgae import PGAE, count_parameters
 from pgae_lite.model.signals import SIGNAL_PROBS, make_batch, sample_signals
-from pgae_lite.data.toy import toy_dataset
-from pgae_lite.model.loss import pgae_loss
 from pgae_lite.util.checks import MAX_SEED, whole_number
-from pgae_lite.exercises.result import (RAISED, CheckResult, _build, _call, _compare, _diagnose, _numbers,
-                     _pair, _shape, _unchanged, _value_problem)
+from pgae_lite.world.words import DESCRIPTIONS, SIGNALS, word_weights
 
 LSTM_EQUATION = ("[i; j; f; o] = x W_x + h W_h + b, c_t = σ(f + 0.8 + p_f ⊙ c_{t-1}) ⊙ c_{t-1} "
                  "+ σ(i + p_i ⊙ c_{t-1}) ⊙ tanh(j), h_t = σ(o + p_o ⊙ c_t) ⊙ tanh(c_t)")

@@ -13,12 +13,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import nrmse, predict
-from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
-from pgae_lite.world.colours import MIN_COLOUR_DIFFERENCE, World, nearest_seen
 from pgae_lite.exercises.result import RAISED, CheckResult, _call, _numbers
+from pgae_lite.world.colours import MIN_COLOUR_DIFFERENCE, World, nearest_seen
+from pgae_lite.world.words import COLOURS, SIGNALS, VOCABULARY
 
 #: Describe accuracy (%) on the held-out episodes that move the new colour's cube.
 MIN_DESCRIBE_ACCURACY = 75.0

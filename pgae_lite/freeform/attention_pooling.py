@@ -77,6 +77,7 @@ class AttentionConfig(Part):
     transformer's top layer tuned."""
 
     kind: ClassVar[str] = "pretrained-attention"
+    slot: ClassVar[str] = "language"
     model: str | None = None
     tuned_top_layer: bool = False
 

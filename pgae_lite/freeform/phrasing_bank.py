@@ -50,6 +50,7 @@ class PhrasingsConfig(Part):
     less :func:`~pgae_lite.freeform.phrase_lexicon.held_out_words` (see the module)."""
 
     kind: ClassVar[str] = "phrasings"
+    slot: ClassVar[str] = "phrasings"
     per_meaning: int = 60
     # Chosen on generated validation sentences (experiments/validation_readback.py), never on the test
     # paraphrases (experiments/HISTORY.md).
@@ -86,10 +87,10 @@ class PhrasingBank:
 
     def __init__(self, encoder: torch.nn.Module, per_meaning: int, seed: int = 0,
                  lexicon: PhraseLexicon | None = None, signals: tuple[str, ...] | None = None,
-                 prob: float = 0.75):   # 0.75: TrainConfig.phrasing_prob's default
+                 prob: float = 0.75):   # 0.75: PhrasingsConfig.prob's default
         if not encoder.reads_free_text:
             raise ValueError("phrasings need a pretrained language encoder (ModelConfig."
-                             "language_encoder='pretrained' or 'pretrained-attention'); this model has "
+                             "language=PretrainedConfig() or AttentionConfig()); this model has "
                              f"{type(encoder).__name__}")
         self.per_meaning, self.encoder, self.prob = per_meaning, encoder, prob
         # only the signals that read phrasings are encoded (the others' rows would never be read)

@@ -33,6 +33,18 @@ def whole(owner: str, name: str, value, low: int, meaning: str = "") -> None:
         raise ValueError(f"{owner} {name} must be a whole number >= {low}{meaning}; got {value!r}")
 
 
+def check_part(owner: str, name: str, part, config) -> None:
+    """A ValueError unless ``part`` is None or a :class:`Part` whose slot is ``name`` and that can go with the rest
+    of ``config`` (the config holding it, ``owner``)."""
+    if part is None:
+        return
+    if not isinstance(part, Part) or part.slot != name:
+        what = f"{type(part).__name__}, the settings of {part.slot}" if isinstance(part, Part) else repr(part)
+        raise ValueError(f"{owner} {name} must be None or the settings of its {name} (see the module "
+                         f"pgae_lite.{'model' if owner == 'ModelConfig' else 'train'}.config); got {what}")
+    part.check(config)
+
+
 def flag(owner: str, name: str, value) -> None:
     """A ValueError unless ``value`` is True or False."""
     if not isinstance(value, bool):
@@ -41,9 +53,11 @@ def flag(owner: str, name: str, value) -> None:
 
 @dataclass(frozen=True)
 class Part:
-    """An optional part of a recipe, beside the code that reads it: its ``kind`` names it in a recipe's dict."""
+    """An optional part of a recipe, beside the code that reads it: its ``kind`` names it in a recipe's dict, its
+    ``slot`` says which setting of a config holds it (``ModelConfig.language``, ``TrainConfig.phrasings``, ...)."""
 
     kind: ClassVar[str] = "part"
+    slot: ClassVar[str] = ""
 
     def check(self, owner) -> None:
         """Raise a ValueError if this part cannot go with the rest of ``owner`` (the config holding it)."""
@@ -52,7 +66,7 @@ class Part:
         return {"kind": self.kind, **asdict(self)}
 
 
-@dataclass
+@dataclass(slots=True)     # a setting it does not have is an error, not a new attribute
 class ModelConfig:
     """Architecture of PGAE and its family (:func:`pgae_lite.model.build.build_model`). Defaults: the
     ``book`` recipe's PGAE. Sizes follow the authors' code: LSTMs of 100 units in 2 layers, h of 50."""
@@ -94,12 +108,7 @@ class ModelConfig:
         whole("ModelConfig", "plan_keyframes", self.plan_keyframes, 0, " (0 = no plan head, the paper's)")
         whole("ModelConfig", "time_stride", self.time_stride, 1, " (1 = every step, the paper's)")
         for name in PARTS:
-            part = getattr(self, name)
-            if part is not None and not isinstance(part, Part):
-                raise ValueError(f"ModelConfig {name} must be None or a part's settings (e.g. "
-                                 f"pgae_lite.bert.config.PretrainedConfig()); got {part!r}")
-            if part is not None:
-                part.check(self)
+            check_part("ModelConfig", name, getattr(self, name), self)
         if self.crossmodal is not None and self.binding is not None:
             raise ValueError("a model has one bottleneck: PTAE's crossmodal transformer (crossmodal) or PRAE's "
                              "and PVAE's binding loss (binding), not both")
@@ -114,4 +123,4 @@ class ModelConfig:
         return d | {name: None if d[name] is None else d[name].to_dict() for name in PARTS}
 
 
-__all__ = ["CELLS", "JOINT_FEEDBACKS", "ModelConfig", "PARTS", "Part", "flag", "whole"]
+__all__ = ["CELLS", "JOINT_FEEDBACKS", "ModelConfig", "PARTS", "Part", "check_part", "flag", "whole"]

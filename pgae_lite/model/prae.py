@@ -52,6 +52,7 @@ class BindingConfig(Part):
     descriptions at random (PVAE's authors); else the first (PRAE's paper: one description per action)."""
 
     kind: ClassVar[str] = "binding"
+    slot: ClassVar[str] = "binding"
     variational: bool = False
     all_descriptions: bool = False
 

@@ -49,6 +49,7 @@ class CrossmodalConfig(Part):
     authors: 4 heads, 256, 1024, dropout 0.25, no positions on the frames."""
 
     kind: ClassVar[str] = "crossmodal-transformer"
+    slot: ClassVar[str] = "crossmodal"
     heads: int = 4
     # Deviation from paper: a feed-forward of 512 (PTAE: 1024), no dropout (PTAE: 0.25), and the frames read
     # with their positions (PTAE: none; push and pull visit the same poses in opposite orders). Each change
@@ -101,6 +102,11 @@ class TokenEmbedding(LanguageEncoderBase):
         self.dropout = nn.Dropout(cfg.crossmodal.dropout)
         self.norm = nn.LayerNorm(cfg.hidden)
         self.output_dim = cfg.hidden
+
+    def encode_texts(self, texts: list[str]) -> torch.Tensor:
+        """Free text: not for PTAE, which reads one-hot tokens of the dataset's words."""
+        raise LanguageError("PTAE reads only the dataset's words, as tokens (pgae_lite.model.signals.make_batch); "
+                            "free text needs PGAE-BERT")
 
     def forward(self, tokens: torch.Tensor) -> torch.Tensor:
         if self.signal_shift:                                                     # signal 23 + s -> V + s

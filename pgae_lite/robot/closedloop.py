@@ -48,13 +48,13 @@ from tqdm.auto import tqdm
 
 from pgae_lite.cae import ChannelSeparatedCAE, extract_features
 from pgae_lite.config import PROFILES
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset, description_text
-from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
+from pgae_lite.freeform.refusals import check_instruction
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
-from pgae_lite.freeform.refusals import check_instruction
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.sim.record import Execution, Simulation, shared_simulation
 from pgae_lite.sim.robot import HOME_POSE
 from pgae_lite.viz import animate_frames

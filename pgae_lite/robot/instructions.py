@@ -17,17 +17,17 @@ import pandas as pd
 import torch
 from tqdm.auto import tqdm
 
-from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.bert.pretrained import check_texts, input_text
 from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import predict
+from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
+from pgae_lite.freeform.refusals import refusal
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import EOS, SIGNAL_TOKEN
 from pgae_lite.robot.closedloop import execute_episode, spread, variation_of
-from pgae_lite.freeform.refusals import refusal
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.util.checks import whole_number
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import WORD_INDEX, LanguageError, parse_description, signal_index, tokenize

@@ -36,18 +36,23 @@ import torch
 from pgae_lite.bert.pretrained import input_text
 from pgae_lite.cae import ChannelSeparatedCAE
 from pgae_lite.config import PROFILES
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset, description_text
-from pgae_lite.sim.dataset import DatasetConfig
+from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.freeform.refusals import check_instruction, disagreement
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
 from pgae_lite.robot.instructions import acted_on, check_route
 from pgae_lite.robot.play_result import TARGETS, PlayResult
-from pgae_lite.robot.playground_checks import (LAST_PATTERN, action_number, arrangement_number, check_objects,
-                                                check_playground)
-from pgae_lite.freeform.refusals import check_instruction, disagreement
+from pgae_lite.robot.playground_checks import (
+    LAST_PATTERN,
+    action_number,
+    arrangement_number,
+    check_objects,
+    check_playground,
+)
 from pgae_lite.robot.typed_text import read_typed
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.util.checks import instance_of, whole_number
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.world import patterns
@@ -79,7 +84,7 @@ def action_label(action: int) -> str:
     return f"{act} the {'left' if side == 'L' else 'right'} cube, {speed}"
 
 
-def pattern_number(arrangement: int, action: int) -> int:
+def scene_pattern(arrangement: int, action: int) -> int:
     """The pattern (0-143) of action ``action`` (0-11) in arrangement ``arrangement`` (0-11)."""
     arrangement, action = arrangement_number(arrangement), action_number(action)
     return patterns.pattern_number(action // 6, arrangement, action % 6)
@@ -128,7 +133,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     signal, text, choice or object. A typed text is parsed once (:func:`~pgae_lite.robot.typed_text.read_typed`).
     """
     check_objects(model, cae, normaliser, data, config)
-    pattern_number(arrangement, action)                    # checks both
+    scene_pattern(arrangement, action)                    # checks both
     instance_of("text", text, str, "a description (a string)", optional=True)
     signal, text = normalise_signal(signal), (text or "").strip()
     check_route(route)
@@ -139,7 +144,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
                          "joints from what its camera sees (choose execute, or the open loop)")
     typed = read_typed(model.language_encoder, signal, text) if text else None   # parsed once, here
     words = typed.words if typed else None
-    pattern = pattern_for(typed.meaning, arrangement) if words else pattern_number(arrangement, action)
+    pattern = pattern_for(typed.meaning, arrangement) if words else scene_pattern(arrangement, action)
     row, sim_variation = find_episode(data, pattern, variation)
     device = next(model.parameters()).device
     tensors = normaliser.tensors(data.subset([row]), device)
@@ -261,4 +266,4 @@ class Playground:
 
 
 __all__ = ["ACTIONS", "PLAY_SIGNALS", "TARGETS", "PlayResult", "Playground", "action_label", "arrangement_label",
-           "find_episode", "pattern_number", "play", "simulator_config"]
+           "find_episode", "scene_pattern", "play", "simulator_config"]

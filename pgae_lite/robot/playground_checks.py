@@ -10,8 +10,8 @@ from __future__ import annotations
 from typing import Mapping
 
 from pgae_lite.cae import ChannelSeparatedCAE
-from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.evaluate.table1 import check_model_inputs
+from pgae_lite.sim.dataset import DatasetConfig
 from pgae_lite.util.checks import instance_of, shown, whole_number
 from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
 from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, pattern_parts

@@ -11,8 +11,8 @@ found is the project's lab log (``experiments/HISTORY.md``), not the book.
 """
 from __future__ import annotations
 
-from statistics import median
 from dataclasses import dataclass
+from statistics import median
 
 import pandas as pd
 

@@ -34,10 +34,14 @@ from pgae_lite.runs.sweep import run_sweep
 from pgae_lite.train.config import TRAIN_PARTS, TrainConfig
 from pgae_lite.train.supervision import SupervisionConfig
 from pgae_lite.util.checks import instance_of
-from pgae_lite.util.storage import (CorruptCheckpointError, FolderBusyError, cache_dir, config_digest,
-                                    default_device, load_torch)
-# TEMPORARY (while the chapters and tests move to pgae_lite.runs.data): the data pipeline's names
-from pgae_lite.runs.data import cae_path, simulated_dataset, trained_cae  # noqa: F401, E402
+from pgae_lite.util.storage import (
+    CorruptCheckpointError,
+    FolderBusyError,
+    cache_dir,
+    config_digest,
+    default_device,
+    load_torch,
+)
 
 if TYPE_CHECKING:
     import torch
@@ -82,7 +86,7 @@ def trained_model(training: Training, profile: Profile, seed: int = 0, device: s
     from pgae_lite.train.checkpoint import CHECKPOINT, DataMismatchError
 
     instance_of("training", training, Training, "a Training of pgae_lite.runs.rows (e.g. TRAININGS['PGAE'])")
-    dataset = loaded(SimulatedData(profile_of(profile)), device, progress)
+    dataset = _with_both_splits(loaded(SimulatedData(profile_of(profile)), device, progress))
     prof = unit_profile(profile, training, seed, dataset)
     folder = model_folder(prof, training.name)
     while True:
@@ -144,6 +148,8 @@ def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, d
     import torch
 
     prof = profile_of(profile)
+    for training in trainings:
+        instance_of("training", training, Training, "a Training of pgae_lite.runs.rows (e.g. TRAININGS['PGAE'])")
     cpu = torch.device(device or default_device()).type == "cpu"
     dataset = _with_both_splits(loaded(SimulatedData(prof), device, progress))   # made before the workers read it
     todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed, dataset)]

@@ -34,9 +34,9 @@ from pgae_lite.bert.pretrained import model_source
 from pgae_lite.config import Profile, get_profile
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import Predictions, format_table
+from pgae_lite.runs.data import data_source, loaded, remember
 from pgae_lite.runs.rows import ROWS, TABLE1_ROWS
 from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
-from pgae_lite.runs.data import data_source, loaded, remember
 from pgae_lite.runs.table1_unit import check_made_on, table1_unit
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError

@@ -23,6 +23,7 @@ import contextlib
 import os
 import sys
 import time
+import uuid
 from pathlib import Path
 
 SCHEDULER_ENV = "PGAE_DASK_SCHEDULER"
@@ -91,8 +92,9 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
         if progress and client.dashboard_link:
             print(f"{name}: Dask dashboard at {client.dashboard_link}", flush=True)
         width = max(1, len(client.scheduler_info().get("workers", {})))
+        sweep = uuid.uuid4().hex[:12]        # this sweep's tasks: on a shared cluster, never another sweep's
         futures = [client.submit(_logged, work, None if logs is None else str(Path(logs) / f"{name}-{k}.log"),
-                                 *unit, key=f"{name}-{k}", pure=False)
+                                 *unit, key=f"{name}-{sweep}-{k}", pure=False)
                    for k, unit in enumerate(units)]
         index = {f.key: k for k, f in enumerate(futures)}
         results: list = [None] * len(units)

@@ -20,13 +20,11 @@ import platform
 from pathlib import Path
 
 from pgae_lite.config import Profile
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.runs.data import data_source, loaded
 from pgae_lite.runs.pipeline import train_when_free, unit_profile
-# TEMPORARY (while the benchmarks move to pgae_lite.runs.data)
-from pgae_lite.runs.data import worker_dataset  # noqa: F401, E402
 from pgae_lite.runs.rows import Row, Training
 from pgae_lite.train.checkpoint import check_trained_on, training_split
 from pgae_lite.util.storage import cache_dir

@@ -42,8 +42,7 @@ from tqdm.auto import tqdm
 from pgae_lite.data.dataset import PGAEDataset, from_recordings
 from pgae_lite.sim.record import Episode, SimConfig, record_episode
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import (array_digest, atomic_write, atomic_write_text, cache_dir, config_digest,
-                                    make_folder)
+from pgae_lite.util.storage import array_digest, atomic_write, atomic_write_text, cache_dir, config_digest, make_folder
 from pgae_lite.world.colours import DEFAULT_WORLD, PAPER_PATTERNS, World
 
 #: Bump when the simulator changes what it records: old caches are then not reused.

@@ -39,7 +39,6 @@ from pgae_lite.sim._quiet import silenced
 from pgae_lite.sim.robot import Robot
 from pgae_lite.world.colours import CUBE_RGBA, TABLE_RGBA
 
-
 CUBE_SIZE = 0.05                          # edge length (m)
 CUBE_MASS = 0.08                          # kg (a hollow wooden toy block)
 CUBE_Y = 0.08                             # |y| of the cube centres (left +, right -)

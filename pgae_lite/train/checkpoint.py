@@ -12,15 +12,13 @@ from pathlib import Path
 
 import numpy as np
 import torch
-
 from torch import nn
 
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.train.config import RECIPE_VERSION
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import (CheckpointMismatchError, CorruptCheckpointError, load_torch,
-                                    save_torch)
+from pgae_lite.util.storage import CheckpointMismatchError, CorruptCheckpointError, load_torch, save_torch
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.

@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, fields
 
 from pgae_lite.data.normaliser import check_vision_scaling
-from pgae_lite.model.config import Part, flag, whole
+from pgae_lite.model.config import Part, check_part, flag, whole
 from pgae_lite.model.signals import SIGNAL_PROBS
 from pgae_lite.world.words import SIGNALS
 
@@ -48,7 +48,7 @@ def number(owner: str, name: str, value, low: float, high: float = math.inf, *, 
         raise ValueError(f"{owner} {name} must be a number {bound}{' or None' if optional else ''}; got {value!r}")
 
 
-@dataclass
+@dataclass(slots=True)     # a setting it does not have is an error, not a new attribute
 class TrainConfig:
     """How a model is trained. Defaults are the ``book`` recipe."""
 
@@ -122,12 +122,7 @@ class TrainConfig:
         if self.max_train_samples is not None:
             whole("TrainConfig", "max_train_samples", self.max_train_samples, 1, " or None (all)")
         for name in TRAIN_PARTS:
-            part = getattr(self, name)
-            if part is not None and not isinstance(part, Part):
-                raise ValueError(f"TrainConfig {name} must be None or a part's settings (e.g. "
-                                 f"pgae_lite.train.supervision.SupervisionConfig(0.05)); got {part!r}")
-            if part is not None:
-                part.check(self)
+            check_part("TrainConfig", name, getattr(self, name), self)
 
     def to_dict(self) -> dict:
         """Every setting as plain values, each part as its dict (None where unset): what a recipe saves."""

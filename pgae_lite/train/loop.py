@@ -26,8 +26,8 @@ import torch
 from torch import nn
 from tqdm.auto import tqdm
 
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.build import build_model
 from pgae_lite.train.checkpoint import CHECKPOINT, check_trained_on, load_checkpoint, save_checkpoint, training_split
 from pgae_lite.train.draws import Draws

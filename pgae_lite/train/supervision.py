@@ -18,10 +18,10 @@ execute 3/7, repeat both 1/7 when paired; repeat action and repeat language 1/2 
 """
 from __future__ import annotations
 
-import torch
-
 from dataclasses import dataclass
 from typing import ClassVar
+
+import torch
 
 from pgae_lite.model.config import Part
 from pgae_lite.model.signals import DESCRIBE, EXECUTE, REPEAT_ACTION, REPEAT_BOTH, REPEAT_LANGUAGE, sample_signals
@@ -38,6 +38,7 @@ class SupervisionConfig(Part):
     samples, is paired (see the module)."""
 
     kind: ClassVar[str] = "supervision"
+    slot: ClassVar[str] = "supervision"
     share: float
     of: str = "updates"
 

@@ -33,17 +33,17 @@ import torch
 
 from pgae_lite.bert.pretrained import fixed_token_rows, tokens_to_text
 from pgae_lite.config import Profile
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.data.dataset import PGAEDataset
+from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
 from pgae_lite.runs.data import SimulatedData, loaded, profile_of
 from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import TRAININGS
+from pgae_lite.sim.record import scene_layout
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
 from pgae_lite.web.export import to_onnx
 from pgae_lite.web.free_text import export_free_text
 from pgae_lite.web.sim_runs import simulator_runs
-from pgae_lite.sim.record import scene_layout
 from pgae_lite.world.colours import CUBE_RGBA
 from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY

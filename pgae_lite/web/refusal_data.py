@@ -23,9 +23,9 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from pgae_lite.freeform import refusals
 from pgae_lite.freeform.phrasings import phrase_table
 from pgae_lite.freeform.word_lookup import WordLookup, wordnet
-from pgae_lite.freeform import refusals
 from pgae_lite.web.word_table import candidates
 from pgae_lite.world.words import COLOURS
 
