@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from pgae_lite.evaluate.incongruent import joint_nrmse, meanings, shown_instead, swapped_words
+from pgae_lite.evaluate.incongruent import meanings, shown_instead, swapped_words
 from pgae_lite.world.patterns import pattern_parts
 from pgae_lite.world.words import CANONICAL, VOCABULARY, WORD_INDEX
 
@@ -38,7 +38,10 @@ def test_the_recording_shown_differs_from_the_sample_by_its_kind_alone(toy, kind
 
 
 def test_the_joint_error_is_table_1s(toy_tensors, toy):
-    from pgae_lite.evaluate.table1 import Predictions, nrmse
+    """One nRMSE in the book: the incongruent cells' and the closed loop's are Table 1's (evaluate.table1)."""
+    from pgae_lite.evaluate import incongruent
+    from pgae_lite.evaluate.table1 import Predictions, joint_nrmse, nrmse
+    from pgae_lite.robot import closedloop
 
     rng = np.random.default_rng(1)
     target = toy.joints[:10]
@@ -46,4 +49,7 @@ def test_the_joint_error_is_table_1s(toy_tensors, toy):
     mask = toy.mask[:10]
     pred = Predictions("execute", toy.ids[:10], [""] * 10, np.where(mask[..., None], joints, np.nan),
                        np.where(mask[..., None], target, np.nan), np.zeros(10, bool), np.zeros((10, 0)))
-    assert joint_nrmse(joints, target, mask, 2.0) == pytest.approx(nrmse(pred, 2.0)[0])
+    assert incongruent._nrmse(joints, target, mask, 2.0) == nrmse(pred, 2.0)[0]
+    length = int(mask[0].sum())
+    assert closedloop._nrmse(joints[0], target[0], length, 2.0) == joint_nrmse(joints[:1, :length],
+                                                                                target[:1, :length], 2.0)[0]

@@ -28,6 +28,7 @@ import torch
 
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
+from pgae_lite.evaluate.table1 import joint_nrmse
 from pgae_lite.model.signals import SIGNAL_TOKEN, make_batch, signal_ids
 from pgae_lite.world.patterns import pattern_number, pattern_parts
 from pgae_lite.world.words import (
@@ -49,10 +50,9 @@ LANGUAGE_CONFLICTS = ("action", "colour", "speed")      # which word of the desc
 ACTION_CONFLICTS = ("action", "position", "speed")      # what differs in the recording shown
 
 
-def joint_nrmse(joints: np.ndarray, target: np.ndarray, mask: np.ndarray, joint_range: float) -> float:
-    """nRMSE (%) of joints (n, T, 5) against target over the steps 1.. that ``mask`` (n, T) holds, as Table 1's."""
-    valid = mask[:, 1:, None] & np.ones_like(joints[:, 1:], dtype=bool)     # step 0 is given, not predicted
-    return 100 * float(np.sqrt(((joints[:, 1:] - target[:, 1:]) ** 2)[valid].mean())) / joint_range
+def _nrmse(joints: np.ndarray, target: np.ndarray, mask: np.ndarray, joint_range: float) -> float:
+    """Table 1's nRMSE (%) of joints (n, T, 5) against target over the steps that ``mask`` (n, T) holds."""
+    return joint_nrmse(np.where(mask[..., None], joints, np.nan), target, joint_range)[0]
 
 
 def swapped_words(words: np.ndarray, kind: str, rng: np.random.Generator) -> np.ndarray:
@@ -124,10 +124,10 @@ def incongruent_cells(model, data: PGAEDataset, normaliser: Normaliser, seed: in
         joints = normaliser.joints_to_data(torch.cat([b.start_joints[:, None], model(b)["joints"]], 1)).cpu().numpy()
         both = data.mask[test] & data.mask[shown]                                    # steps both recordings have
         out["action"][kind] = {
-            "nrmse to the described": joint_nrmse(joints, data.joints[test], data.mask[test], joint_range),
-            "nrmse to the shown": joint_nrmse(joints, data.joints[shown], both, joint_range)}
+            "nrmse to the described": _nrmse(joints, data.joints[test], data.mask[test], joint_range),
+            "nrmse to the shown": _nrmse(joints, data.joints[shown], both, joint_range)}
     return out
 
 
-__all__ = ["ACTION_CONFLICTS", "LANGUAGE_CONFLICTS", "incongruent_cells", "joint_nrmse", "meanings",
+__all__ = ["ACTION_CONFLICTS", "LANGUAGE_CONFLICTS", "incongruent_cells", "meanings",
            "shown_instead", "swapped_words"]

@@ -133,16 +133,21 @@ def predict(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser, s
                        np.concatenate(gates))
 
 
-def nrmse(pred: Predictions, joint_range: float) -> tuple[float, float]:
-    """(nRMSE over valid predicted steps, nRMSE the authors' padded way), both in %."""
-    instance_of("pred", pred, Predictions, "the Predictions of predict()")
-    joint_range = positive_number("joint_range", joint_range)
-    err = (pred.joints[:, 1:] - pred.target[:, 1:]) ** 2             # step 0 is given, not predicted
+def joint_nrmse(joints: np.ndarray, target: np.ndarray, joint_range: float) -> tuple[float, float]:
+    """Joints (..., T, 5) against their target over the predicted steps 1.. (step 0 is given), NaN where a sample
+    has no step: (nRMSE over the valid steps, nRMSE the authors' padded way), both in %. Every nRMSE of the book."""
+    err = (joints[..., 1:, :] - target[..., 1:, :]) ** 2             # step 0 is given, not predicted
     valid = ~np.isnan(err)
     sq = np.nansum(err)
     mse_valid = sq / valid.sum()
     mse_padded = sq / err.size                                       # padded steps count as 0 error
     return 100 * float(np.sqrt(mse_valid)) / joint_range, 100 * float(np.sqrt(mse_padded)) / joint_range
+
+
+def nrmse(pred: Predictions, joint_range: float) -> tuple[float, float]:
+    """(nRMSE over valid predicted steps, nRMSE the authors' padded way) of one signal's predictions, both in %."""
+    instance_of("pred", pred, Predictions, "the Predictions of predict()")
+    return joint_nrmse(pred.joints, pred.target, positive_number("joint_range", joint_range))
 
 
 def evaluate(model: torch.nn.Module, data: PGAEDataset, normaliser: Normaliser, split: str = "test",

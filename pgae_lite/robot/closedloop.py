@@ -50,7 +50,7 @@ from pgae_lite.cae import ChannelSeparatedCAE, extract_features
 from pgae_lite.config import PROFILES
 from pgae_lite.data.dataset import PGAEDataset, description_text
 from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.evaluate.table1 import predict
+from pgae_lite.evaluate.table1 import joint_nrmse, predict
 from pgae_lite.freeform.refusals import check_instruction
 from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import SignalBatch, make_batch, signal_ids
@@ -196,9 +196,8 @@ def variation_of(sample_id: str) -> int:
 
 
 def _nrmse(pred: np.ndarray, target: np.ndarray, length: int, joint_range: float) -> float:
-    """nRMSE (%) of one sample over its predicted steps 1..length-1, as in evaluation."""
-    err = pred[1:length] - target[1:length]
-    return 100 * float(np.sqrt(np.mean(err ** 2))) / joint_range
+    """nRMSE (%) of one sample over its predicted steps 1..length-1, as Table 1's."""
+    return joint_nrmse(pred[:length], target[:length], joint_range)[0]
 
 
 def spread(n: int, limit: int | None) -> np.ndarray:
