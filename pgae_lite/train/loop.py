@@ -29,7 +29,14 @@ from tqdm.auto import tqdm
 from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.model.build import build_model
-from pgae_lite.train.checkpoint import CHECKPOINT, check_trained_on, load_checkpoint, save_checkpoint, training_split
+from pgae_lite.train.checkpoint import (
+    CHECKPOINT,
+    check_recipe_version,
+    check_trained_on,
+    load_checkpoint,
+    save_checkpoint,
+    training_split,
+)
 from pgae_lite.train.draws import Draws
 from pgae_lite.train.optimiser import lr_factor, parameter_groups
 from pgae_lite.train.supervision import labelled_samples
@@ -173,6 +180,7 @@ def _setup(train_set: PGAEDataset, normaliser: Normaliser, profile, device: torc
 def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) -> None:
     """Continue from the checkpoint at ``path``: the same recipe and data, or a clear error."""
     ckpt = load_checkpoint(path)
+    check_recipe_version(ckpt["profile"], path)          # an older meaning of the options: said so
     if ckpt["profile"] != profile.to_dict():
         raise CheckpointMismatchError(
             f"{path} was trained with a different profile or seed; use another output "
