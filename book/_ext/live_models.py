@@ -17,10 +17,10 @@ logger = logging.getLogger(__name__)
 def export(app, exception):
     if exception is not None or app.builder.format != "html":
         return
-    from pgae_lite.config import profile_name
+    from pgae_lite.config import get_profile
     from pgae_lite.web.assets import export_web
 
-    manifest = export_web(Path(app.outdir) / "_static" / "web", profile_name())
+    manifest = export_web(Path(app.outdir) / "_static" / "web", get_profile())     # the profile, resolved here
     sizes = sum(m["bytes"] for m in manifest["models"].values())
     free = (manifest["free_text"] or {}).get("bytes", 0)
     logger.info(f"live playground: {len(manifest['models'])} models ({sizes / 1e6:.1f} MB of graphs, "
