@@ -45,8 +45,8 @@ class PretrainedConfig(Part):
     tuned_top_layer: bool = False
 
     def __post_init__(self):
-        check_model("PretrainedConfig", self.model)
-        flag("PretrainedConfig", "tuned_top_layer", self.tuned_top_layer)
+        check_model(type(self).__name__, self.model)
+        flag(type(self).__name__, "tuned_top_layer", self.tuned_top_layer)
 
     def build(self, lexicon: Lexicon = DEFAULT_LEXICON) -> LanguageEncoderBase:
         """The encoder these settings describe, for a model of ``lexicon``'s words (the paper's)."""

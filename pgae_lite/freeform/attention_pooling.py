@@ -31,7 +31,7 @@ from typing import ClassVar
 import torch
 from torch import nn
 
-from pgae_lite.bert.config import check_model, check_words
+from pgae_lite.bert.config import PretrainedConfig, check_words
 from pgae_lite.bert.pretrained import (
     Transformer,
     cached_token_vectors,
@@ -46,7 +46,6 @@ from pgae_lite.bert.pretrained import (
 )
 from pgae_lite.bert.tuned_layer import TopLayerHead, TunedTopLayer
 from pgae_lite.freeform.word_lookup import WordLookup
-from pgae_lite.model.config import Part, flag
 from pgae_lite.model.language import LanguageEncoderBase
 from pgae_lite.world.words import DEFAULT_LEXICON, Lexicon
 
@@ -71,19 +70,12 @@ class AttentionPooling(nn.Module):
 
 
 @dataclass(frozen=True)
-class AttentionConfig(Part):
-    """The free-form variant's encoder (``ModelConfig.language``): the transformer ``model`` (None: the default
-    the project ships) read through a trained attention pooling; with ``tuned_top_layer``, free text reads the
-    transformer's top layer tuned."""
+class AttentionConfig(PretrainedConfig):
+    """The free-form variant's encoder (``ModelConfig.language``): PGAE-BERT's settings (the transformer ``model``,
+    None for the default the project ships), its tokens read through a trained attention pooling; with
+    ``tuned_top_layer``, free text reads the transformer's top layer tuned."""
 
     kind: ClassVar[str] = "pretrained-attention"
-    slot: ClassVar[str] = "language"
-    model: str | None = None
-    tuned_top_layer: bool = False
-
-    def __post_init__(self):
-        check_model("AttentionConfig", self.model)
-        flag("AttentionConfig", "tuned_top_layer", self.tuned_top_layer)
 
     def build(self, lexicon: Lexicon = DEFAULT_LEXICON) -> LanguageEncoderBase:
         """The encoder these settings describe, for a model of ``lexicon``'s words (the paper's)."""
