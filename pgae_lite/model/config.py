@@ -5,11 +5,11 @@ representation, its action decoder's feedback and time stride, and the two optio
 bottleneck and plan head. What only some models read lives in a part beside their code, ``None`` in
 the plain recipe (PGAE):
 
-    language    a pretrained language encoder in place of the LSTM over one-hot words:
-                PGAE-BERT's (:class:`pgae_lite.bert.config.PretrainedConfig`) or the free-form
-                variant's (:class:`pgae_lite.freeform.attention_pooling.AttentionConfig`)
-    crossmodal  PTAE's crossmodal transformer in place of the GMU (:class:`pgae_lite.model.ptae.CrossmodalConfig`)
-    binding     PRAE's and PVAE's two autoencoders bound by a loss (:class:`pgae_lite.model.prae.BindingConfig`)
+- ``language``: a pretrained language encoder in place of the LSTM over one-hot words: PGAE-BERT's
+  (:class:`pgae_lite.bert.config.PretrainedConfig`) or the free-form variant's
+  (:class:`pgae_lite.freeform.attention_pooling.AttentionConfig`);
+- ``crossmodal``: PTAE's crossmodal transformer in place of the GMU (:class:`pgae_lite.model.ptae.CrossmodalConfig`);
+- ``binding``: PRAE's and PVAE's two autoencoders bound by a loss (:class:`pgae_lite.model.prae.BindingConfig`).
 
 Every part is a :class:`Part`: frozen, checked where it is made, written into a recipe's dict with
 its ``kind``. The defaults are the ``book`` recipe; the paper's own settings are the ``paper``

@@ -3,11 +3,11 @@
 Paper, Sec. 3: PGAE reads its language through an LSTM over one-hot words; PGAE-BERT through a
 frozen pretrained transformer. The book adds encoders of its own (the free-form variant's,
 PVAE-BERT's tuned one). Whatever reads a model's language (the training loop, the playground,
-the refusal rule, the page's export) asks the encoder through this interface, never by its type:
+the refusal rule, the page's export) asks the encoder through this interface, never by its type::
 
     output_dim               the size of the features f_lang it gives the bottleneck
     forward(tokens, lengths) ``lang_tokens`` rows (B, 5) -> f_lang (B, output_dim)
-    reads_free_text          whether :meth:`encode_texts` reads any text (a pretrained transformer)
+    reads_free_text          whether encode_texts reads any text (a pretrained transformer)
     encode_texts(texts)      free text, the signal phrase first -> f_lang (B, output_dim)
     read_as(text)            the text as the encoder reads it (a word lookup may rewrite it)
     word_lookup              what reads words training never held (a WordLookup), or None

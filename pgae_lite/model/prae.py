@@ -16,7 +16,7 @@ Two autoencoders on this package's encoders and decoders (:mod:`pgae_lite.model.
 and the loss is the words' cross-entropy + the joints' MSE + the binding loss on (z_L, z_A)
 (:func:`pgae_lite.model.binding.binding_loss`). It is trained on paired samples only (the signal
 ``repeat both``), by the one training loop (:mod:`pgae_lite.train.loop`), and measured per
-configuration: each signal is one path, and a cell it has no path for is N.A. (:data:`PRAE.PATHS`)::
+configuration: each signal is one path, and a cell it has no path for is N.A. (``PRAE.PATHS``)::
 
     | signal          | path                                | words  | joints |
     |-----------------|-------------------------------------|--------|--------|

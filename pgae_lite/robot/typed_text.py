@@ -7,7 +7,7 @@ run reads from (:func:`pgae_lite.robot.playground.play`, and the closed loop it 
 - ``words``: the description it is (``action colour speed``, synonyms kept), or None for free text,
   and ``meaning``, its parse (the canonical action, colour and speed);
 - ``read``: the text as the model's language encoder reads it
-  (:meth:`~pgae_lite.model.pgae.LanguageEncoder.read_as`: for the free-form
+  (:meth:`~pgae_lite.model.language.LanguageEncoderBase.read_as`: for the free-form
   variant, with its words never trained on looked up in WordNet; else as typed);
 - :meth:`TypedText.features`: the encoder's features of the text after a signal's phrase, computed
   once per signal and kept, so each distinct input runs the transformer once.

@@ -7,7 +7,7 @@ paper trained it otherwise, its authors' settings, which a profile with ``author
 ``paper`` profile) uses. A :class:`Row` is one line of Table 1 or of the family's table beside it:
 a training, whether it is measured on the other agent's actions, and the paper's figures, if the
 paper's Table 1 has the row. Which cells a row has follows from its model (``PATHS``: N.A. where it
-has no path, :func:`pgae_lite.evaluate.table1.evaluate`). Nothing anywhere branches on these names.
+has no path, :func:`pgae_lite.evaluate.table1.evaluate`). Nothing anywhere branches on these names::
 
     | row           | training         | builds                                   | measured on            |
     |---------------|------------------|------------------------------------------|------------------------|

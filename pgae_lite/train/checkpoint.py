@@ -80,7 +80,8 @@ def check_trained_on(ckpt: dict, fitted: dict, path: str | Path, source: str = "
 
 
 def check_recipe_version(recipe, path: str | Path) -> dict:
-    """``recipe`` (a checkpoint's saved ``Profile.to_dict()``) if it was trained with this :data:`RECIPE_VERSION`;
+    """``recipe`` (a checkpoint's saved ``Profile.to_dict()``) if it was trained with this
+    :data:`~pgae_lite.train.config.RECIPE_VERSION`;
     else a :class:`~pgae_lite.util.storage.CheckpointMismatchError` that says so."""
     version = recipe.get("recipe_version") if isinstance(recipe, dict) else None
     if version != RECIPE_VERSION:

@@ -5,10 +5,10 @@ optimiser and its schedule, the random draws of each step (signals, views, input
 weights of the models trained on signals, the seed and the checkpoints. What only some trainings
 read lives in a part beside its code, ``None`` in the plain recipe:
 
-    supervision  limited supervision, a share of the updates or of the samples paired
-                 (:class:`pgae_lite.train.supervision.SupervisionConfig`)
-    phrasings    the free-form variant's phrasings of every instruction
-                 (:class:`pgae_lite.freeform.phrasing_bank.PhrasingsConfig`)
+- ``supervision``: limited supervision, a share of the updates or of the samples paired
+  (:class:`pgae_lite.train.supervision.SupervisionConfig`);
+- ``phrasings``: the free-form variant's phrasings of every instruction
+  (:class:`pgae_lite.freeform.phrasing_bank.PhrasingsConfig`).
 
 The defaults are the ``book`` recipe; the paper's own settings are the ``paper`` profile in
 :mod:`pgae_lite.config`. Every departure is marked ``# Deviation from paper:``; what it measured

@@ -2,10 +2,10 @@
 
 A model says which draws its batches take (``training_batch``, :mod:`pgae_lite.model.loss` and
 :mod:`pgae_lite.model.prae`); this object makes them, from the recipe and the run's generator,
-in the order the model asks:
+in the order the model asks::
 
-    signals(index)       each sample's signal (:data:`TrainConfig.signal_probs`, per sample or per batch;
-                         under limited supervision, :mod:`pgae_lite.train.supervision`)
+    signals(index)       each sample's signal (TrainConfig.signal_probs, per sample or per batch;
+                         under limited supervision, pgae_lite.train.supervision)
     descriptions(size)   which of the 8 equivalent descriptions each sample reads
     views(size)          whether each sample shows the opposite agent (``opposite_prob``)
     noise(action_input)  Gaussian noise on the action encoder's input (``input_noise``, ``joint_input_noise``)
