@@ -21,12 +21,11 @@ from pathlib import Path
 
 from pgae_lite.config import Profile
 from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.runs.data import data_source, loaded
 from pgae_lite.runs.pipeline import train_when_free, unit_profile
 from pgae_lite.runs.rows import Row, Training
-from pgae_lite.train.checkpoint import check_trained_on, training_split
+from pgae_lite.train.checkpoint import check_fitted_on
 from pgae_lite.util.storage import cache_dir
 
 SHARED_WITH_SELF = ("execute", "repeat language")   # no action shown: the opposite view changes nothing
@@ -61,10 +60,7 @@ def table1_unit(original_data: str | None, profile: Profile, training: Training,
 def check_made_on(result: dict, dataset: PGAEDataset, folder: Path) -> None:
     """Raise :class:`~pgae_lite.train.checkpoint.DataMismatchError` unless the unit's model was trained
     on ``dataset`` (the caller's): the same statistics of its training samples, on any machine."""
-    cfg = result["profile"]["train"]
-    fitted = Normaliser.fit(training_split(dataset, cfg["max_train_samples"]), cfg["vision_scaling"]).state_dict()
-    check_trained_on({"normaliser": result["normaliser"]}, fitted, folder,
-                     f"{dataset.source}; the model was trained on {result['made_on']}")
+    check_fitted_on(result, dataset, folder, result["made_on"])
 
 
 __all__ = ["SHARED_WITH_SELF", "check_made_on", "table1_unit"]

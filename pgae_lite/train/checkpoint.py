@@ -110,13 +110,14 @@ def load_weights(model: nn.Module, ckpt: dict, path: str | Path) -> nn.Module:
     return model
 
 
-def check_fitted_on(ckpt: dict, dataset: PGAEDataset, path: str | Path) -> None:
-    """Raise :class:`DataMismatchError` unless the checkpoint's model was trained on ``dataset``: the normaliser
-    fitted on its training samples (with the saved recipe's subset and scaling) equals the one saved."""
+def check_fitted_on(ckpt: dict, dataset: PGAEDataset, path: str | Path, made_on: str = "") -> None:
+    """Raise :class:`DataMismatchError` unless the checkpoint's model (or a sweep unit's result, which holds its
+    recipe and normaliser too) was trained on ``dataset``: the normaliser fitted on its training samples (with the
+    saved recipe's subset and scaling) equals the one saved. ``made_on``: where it was trained, for the message."""
     cfg = ckpt["profile"]["train"]
     fitted = Normaliser.fit(training_split(dataset, cfg.get("max_train_samples")),
                             cfg.get("vision_scaling", "global")).state_dict()
-    check_trained_on(ckpt, fitted, path, dataset.source)
+    check_trained_on(ckpt, fitted, path, dataset.source + (f"; the model was trained on {made_on}" if made_on else ""))
 
 
 __all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "check_fitted_on", "check_recipe_version",
