@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 import shutil
 import threading
+from contextlib import contextmanager
 from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 
@@ -43,3 +44,29 @@ def serve(folder) -> tuple[str, ThreadingHTTPServer]:
     server = _QuietServer(("127.0.0.1", 0), partial(_QuietHandler, directory=str(folder)))
     threading.Thread(target=server.serve_forever, daemon=True).start()
     return f"http://127.0.0.1:{server.server_address[1]}", server
+
+
+@contextmanager
+def offline_page(folder, path: str):
+    """``folder`` served, and ``path`` in it open in Debian's Chromium with every other request aborted and the
+    live models loaded (``window.pgae.load()``): yields (the page, the list its console errors collect in)."""
+    from playwright.sync_api import sync_playwright
+
+    site, server = serve(folder)
+    errors: list[str] = []
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
+            context = browser.new_context()
+            context.route("**/*", lambda r: r.continue_() if r.request.url.startswith(site) else r.abort())
+            page = context.new_page()
+            page.on("console", lambda m: m.type == "error" and not any(k.search(m.text) for k in KNOWN_CONSOLE_ERRORS)
+                    and errors.append(m.text))
+            page.on("pageerror", lambda e: not any(k.search(str(e)) for k in KNOWN_CONSOLE_ERRORS)
+                    and errors.append(str(e)))
+            page.goto(f"{site}/{path}", wait_until="load")
+            page.evaluate("window.pgae.load()")
+            yield page, errors
+            browser.close()
+    finally:
+        server.shutdown()

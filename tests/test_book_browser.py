@@ -13,17 +13,24 @@ for Python, with the system browser: no ``playwright install``):
 - saved widgets and matplotlib animations are drawn;
 - no code line runs past its block, hidden behind a sideways scroll (long lines
   wrap: book/_css/pgae.css), at 1280 px and at a phone's 400 px;
+- no page scrolls sideways at a phone's 390 px nor at 1280 px, and nothing in the
+  text is cut off at the edge of a box (a wide table or formula scrolls in its own
+  box, a plot shrinks, a message wraps: book/_css/pgae.css); the live boxes of
+  chapters 05 and 08 are run first, so that their messages and plots are measured;
 - every link to a page of the book (navigation, sidebar, prev/next, text)
   answers HTTP 200;
 - with no repository address, no launch, repository or issues button; every
   chapter has a link to download it as a notebook.
 
 A full-page screenshot of each page goes to ``_build/screenshots/`` with a
-``report.json`` of what was found and how long each page took. The module is
+``report.json`` of what was found and how long each page took; beside them the
+top of each page at 390 px (``390px-<page>.png``), its live box at 390 px, and
+chapter 08 at 1280 px (``1280px-notebooks_08_playground.png``). The module is
 skipped when the book has not been built, or (unless
 ``PGAE_BROWSER_REQUIRED=1``, as in ``.ci/test``) when Chromium or Playwright is
 missing. Run it after ``jupyter-book build .``:
-``python -m pytest tests/test_book_browser.py``.
+``python -m pytest tests/test_book_browser.py``; ``PGAE_BOOK_SITE=<folder>``
+checks a book built elsewhere.
 """
 from __future__ import annotations
 
@@ -41,7 +48,7 @@ import yaml
 from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve
 
 ROOT = Path(__file__).resolve().parents[1]
-BOOK = ROOT / "_build" / "html"
+BOOK = Path(os.environ.get("PGAE_BOOK_SITE", ROOT / "_build" / "html"))  # the built book
 SCREENSHOTS = ROOT / "_build" / "screenshots"
 
 
@@ -62,7 +69,8 @@ if (_why := _missing_browser()) is not None:
         raise RuntimeError(_why)
     pytest.skip(_why, allow_module_level=True)
 
-from playwright.sync_api import sync_playwright  # noqa: E402 -- only once the browser is known to be there
+from playwright.sync_api import Error as BrowserError  # noqa: E402 -- only once the browser is known to be there
+from playwright.sync_api import sync_playwright  # noqa: E402
 
 
 def toc_pages() -> list[str]:
@@ -93,8 +101,6 @@ def site():
     server.shutdown()
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
     (SCREENSHOTS / "report.json").write_text(json.dumps(REPORT, indent=1), encoding="utf-8")
-
-
 
 
 @pytest.fixture(scope="module")
@@ -189,7 +195,8 @@ def test_page_renders_offline(docname, site, browser):
     page.wait_for_timeout(300)  # let late console messages (fonts, widgets) arrive
     checked = time.perf_counter()
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-    page.screenshot(path=str(SCREENSHOTS / f"{docname.replace('/', '_')}.png"), full_page=True)
+    # The API page is 170,000 px tall at 1280 px: its full-page screenshot takes 20-30 s on a busy machine.
+    page.screenshot(path=str(SCREENSHOTS / f"{docname.replace('/', '_')}.png"), full_page=True, timeout=120_000)
     screenshot_seconds = time.perf_counter() - checked
     context.close()
 
@@ -267,6 +274,109 @@ def test_code_lines_not_cut_off(docname, width, site, browser):
     lines = [line for block in cut for line in block["lines"]]
     assert not cut, (f"{docname} at {width} px: {len(lines)} code lines in {len(cut)} blocks run past "
                      f"the block and are cut off:\n" + "\n".join(lines))
+
+
+# Run in the page once it has loaded: what makes it wider than the screen, and what a box cuts off.
+# An element sticks out when its right edge is past the screen's and no box around it scrolls or
+# clips it within the screen (a table scrolling in its output box is fine); an element drawn fixed
+# (the theme's sidebars, off-canvas on a phone) or hidden does not widen the page. Only the
+# outermost element of each is named. Cut off: in the article, an element that runs more than 2 px
+# past the right edge of a box that hides its overflow (overflow: hidden or clip) with no scrolling
+# box between them; MathJax's invisible copy of each formula for screen readers is left out.
+OVERFLOW = r"""async () => {
+  const imgs = [...document.images];
+  imgs.forEach(img => { img.loading = "eager"; });
+  await Promise.all(imgs.map(img => img.complete ? null
+      : new Promise(done => { img.onload = img.onerror = done; })));
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) await MathJax.startup.promise;
+  await document.fonts.ready;
+  const width = window.innerWidth;
+  const name = el => el.tagName.toLowerCase() + [...el.classList].slice(0, 3).map(c => "." + c).join("");
+  const describe = el => {
+    const r = el.getBoundingClientRect();
+    return `${name(el)} in ${name(el.parentElement)} (${Math.round(r.width)} px wide, right edge at ` +
+           `${Math.round(r.right)} px): ` + JSON.stringify(el.textContent.replace(/\s+/g, " ").trim().slice(0, 60));
+  };
+  const sticksOut = el => {
+    const r = el.getBoundingClientRect();
+    if (!r.width || r.right <= width + 1) return false;
+    const style = getComputedStyle(el);
+    if (style.position === "fixed" || style.visibility === "hidden") return false;
+    for (let box = el.parentElement; box && box !== document.documentElement; box = box.parentElement) {
+      const s = getComputedStyle(box);
+      if (s.position === "fixed") return false;
+      if (s.overflowX !== "visible" && box.getBoundingClientRect().right <= width + 1) return false;
+    }
+    return true;
+  };
+  const out = new Set([...document.body.querySelectorAll("*")].filter(sticksOut));
+  const cut = [];
+  const article = document.querySelector("article.bd-article") || document.body;
+  for (const box of article.querySelectorAll("*")) {
+    if (!["hidden", "clip"].includes(getComputedStyle(box).overflowX) || box.closest("mjx-assistive-mml")) continue;
+    const edge = box.getBoundingClientRect().right;
+    for (const el of box.querySelectorAll("*")) {
+      if (el.closest("mjx-assistive-mml") || el.getBoundingClientRect().right <= edge + 2) continue;
+      let scrolled = false;
+      for (let a = el.parentElement; a !== box; a = a.parentElement)
+        if (["auto", "scroll"].includes(getComputedStyle(a).overflowX)) { scrolled = true; break; }
+      if (!scrolled && el.parentElement.getBoundingClientRect().right <= edge + 2)
+        cut.push(`${describe(el)} cut off by ${name(box)}`);
+    }
+  }
+  return {scrollWidth: document.documentElement.scrollWidth, innerWidth: width,
+          stickingOut: [...out].filter(el => !out.has(el.parentElement)).map(describe), cutOff: cut};
+}"""
+# The live boxes, run once before measuring so that their plots and messages are on the page:
+# chapter 08's playground (its Run button, the first episode) and chapter 05's box (its sentence).
+LIVE_BOXES = {".pgae-live": ("button.pgae-live-run", "dataset.result !== undefined"),
+              ".pgae-understood": ("button", "dataset.done === '1'")}
+
+
+@pytest.mark.parametrize("width", [390, 1280], ids=["phone", "desktop"])
+@pytest.mark.parametrize("docname", PAGES)
+def test_page_fits_the_screen(docname, width, site, browser):
+    """At a phone's 390 px and at 1280 px the page does not scroll sideways and no text is cut off at
+    a box's edge: a wide table or formula scrolls in its own box, plots shrink, messages wrap
+    (book/_css/pgae.css). Saves the top of each page at 390 px, the live boxes at 390 px and
+    chapter 08 at 1280 px."""
+    context = browser.new_context(viewport={"width": width, "height": 844 if width < 800 else 900})
+    context.route("**/*", lambda route: route.continue_() if route.request.url.startswith(site) else route.abort())
+    page = context.new_page()
+    response = page.goto(f"{site}/{docname}.html", wait_until="load")
+    assert response is not None and response.status == 200, f"{docname}.html: {response and response.status}"
+    live_not_run = []
+    for selector, (button, done) in LIVE_BOXES.items():
+        if page.locator(selector).count():
+            try:  # the box's models load, run, and it shows what they said (tests/test_live_playground.py)
+                page.locator(f"{selector} {button}").first.click(timeout=60_000)
+                page.wait_for_function(f"document.querySelector('{selector}').{done}", timeout=60_000)
+            except BrowserError as error:  # measured as it is: whether it runs is test_live_playground.py's
+                live_not_run.append(f"{selector}: {type(error).__name__}")
+    seen = page.evaluate(OVERFLOW)
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    stem = f"{width}px-{docname.replace('/', '_')}"
+    if width == 390:  # the top of the page: full pages at 390 px run to 275,000 px (the API page)
+        height = min(page.evaluate("document.documentElement.scrollHeight"), 8000)
+        page.screenshot(path=str(SCREENSHOTS / f"{stem}.png"), full_page=True,
+                        clip={"x": 0, "y": 0, "width": width, "height": height})
+        for selector in LIVE_BOXES:
+            if page.locator(selector).count():
+                page.locator(selector).first.screenshot(path=str(SCREENSHOTS / f"{stem}-live.png"))
+    elif docname == "notebooks/08_playground":
+        page.screenshot(path=str(SCREENSHOTS / f"{stem}.png"), full_page=True)
+    context.close()
+    REPORT.setdefault(f"{docname} at {width} px", {}).update(
+        scroll_width=seen["scrollWidth"], sticking_out=seen["stickingOut"][:10], cut_off=seen["cutOff"][:10],
+        live_boxes_not_run=live_not_run)
+    problems = []
+    if seen["scrollWidth"] > seen["innerWidth"] + 1:
+        problems.append(f"the page scrolls sideways ({seen['scrollWidth']} px wide on a {seen['innerWidth']} px "
+                        f"screen); sticking out past the right edge:\n  " + "\n  ".join(seen["stickingOut"][:10]))
+    if seen["cutOff"]:
+        problems.append(f"{len(seen['cutOff'])} elements cut off at a box's edge:\n  "
+                        + "\n  ".join(seen["cutOff"][:10]))
+    assert not problems, f"{docname} at {width} px: " + "\n".join(problems)
 
 
 EMPTY_OUTPUT = re.compile(r"Empty DataFrame|<tbody>\s*</tbody>|^\s*\w[\w ]*:? \{\}\s*$|<td>(?:NaN|nan|None)</td>", re.M)

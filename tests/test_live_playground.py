@@ -23,7 +23,7 @@ BOOK = Path(os.environ.get("PGAE_LIVE_SITE", ROOT / "_build" / "html"))
 if not (BOOK / "_static" / "web" / "manifest.json").exists():
     pytest.skip(f"no live playground in {BOOK}: build the book first", allow_module_level=True)
 
-from browser_support import CHROMIUM, CHROMIUM_FLAGS, KNOWN_CONSOLE_ERRORS, serve  # noqa: E402
+from browser_support import CHROMIUM, offline_page  # noqa: E402
 
 from pgae_lite.model.signals import make_batch, signal_ids  # noqa: E402
 from pgae_lite.world.words import TEST_SIGNALS, LanguageError, decode  # noqa: E402
@@ -36,23 +36,8 @@ PAGE = "notebooks/08_playground.html"
 def page():
     if not Path(CHROMIUM).exists():
         pytest.skip(f"no Chromium at {CHROMIUM}")
-    from playwright.sync_api import sync_playwright
-
-    site, server = serve(BOOK)
-    errors = []
-    with sync_playwright() as p:
-        browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_FLAGS)
-        context = browser.new_context()
-        context.route("**/*", lambda r: r.continue_() if r.request.url.startswith(site) else r.abort())
-        pg = context.new_page()
-        pg.on("console", lambda m: m.type == "error" and not any(k.search(m.text) for k in KNOWN_CONSOLE_ERRORS)
-              and errors.append(m.text))
-        pg.on("pageerror", lambda e: not any(k.search(str(e)) for k in KNOWN_CONSOLE_ERRORS) and errors.append(str(e)))
-        pg.goto(f"{site}/{PAGE}", wait_until="load")
-        pg.evaluate("window.pgae.load()")
-        yield pg, errors
-        browser.close()
-    server.shutdown()
+    with offline_page(BOOK, PAGE) as opened:
+        yield opened
 
 
 def _python(name: str):
@@ -90,23 +75,29 @@ def test_the_page_computes_what_pytorch_computes(page, name):
     assert not errors, errors
 
 
-def test_a_typed_description_is_read_and_said_back(page):
-    from pgae_lite.world.words import WORD_INDEX, tokenize
+def test_a_typed_description_picks_its_episode_and_is_said_back_as_play_does(page):
+    """A description typed for PGAE picks the action it names in the chosen scene, as play() does; one naming
+    a cube that is not on the table is refused with play()'s sentence."""
+    from pgae_lite.config import get_profile
+    from pgae_lite.robot.playground import play
+    from pgae_lite.runs.data import simulated_dataset
 
     pg, _ = page
-    text, episode = "Move Up blonde, quickly", MANIFEST["episodes"][0]["id"]
-    r = pg.evaluate("([text, episode]) => window.pgae.run({model: 'PGAE', signal: 'execute', episode, text})",
-                    [text, episode])
-    model, normaliser, test = _python("PGAE")
-    tensors = normaliser.tensors(test.subset([list(map(str, test.ids)).index(episode)]))
-    tensors["descriptions"][:] = torch.tensor([WORD_INDEX[w] for w in tokenize(text)])   # as play() does
-    said = {}
-    for signal in ("execute", "repeat language"):
-        with torch.no_grad():
-            out = model(make_batch(tensors, torch.zeros(1, dtype=torch.long), signal_ids(signal, 1),
-                                   torch.zeros(1, dtype=torch.long)))
-        said[signal] = decode(out["logits"][0].argmax(-1))
-    assert (r["words"], r["understood"]) == (said["execute"], said["repeat language"])
+    ask = """async (args) => { try { return await window.pgae.run(args); } catch (e) { return e.message; } }"""
+    model, normaliser, _ = _python("PGAE")
+    data = simulated_dataset(get_profile(MANIFEST["profile"]), "cpu", progress=False)
+    episode = MANIFEST["episodes"][0]
+    left, right = episode["scene"]
+    absent = next(c for c in ("red", "green", "blue", "yellow", "violet", "cyan") if c not in (left, right))
+    place = {"arrangement": episode["arrangement"], "action": episode["action"]}
+    for text in (f"Move Up {right}, quickly", f"pull {left} slowly", f"push {absent} fast"):
+        got = pg.evaluate(ask, {"model": "PGAE", "signal": "execute", **place, "text": text})
+        try:
+            want = play(model, None, normaliser, data, "execute", text=text, loop=None, **place)
+        except ValueError as e:
+            assert got == str(e), text
+            continue
+        assert (got["episode"], got["words"], got["understood"]) == (want.episode, want.words, want.understood), text
 
 
 @pytest.mark.parametrize("args, typed", [
@@ -150,7 +141,8 @@ def _page_runs(pg, name: str, texts: list[str], episodes: list[str]) -> list[dic
         const out = [];
         for (let i = 0; i < texts.length; i++) {
           try {
-            const r = await window.pgae.run({model, signal: "execute", episode: ids[i], text: texts[i]});
+            const r = await window.pgae.run({model, signal: "execute", episode: ids[i], text: texts[i],
+                                             route: "direct"});
             out.push({...r, read: await window.pgae.readAs(model, texts[i])});
           } catch (e) { out.push({refused: e.message}); }
         }
@@ -196,8 +188,8 @@ def test_unknown_model_signal_and_episode_are_refused(page):
     assert "unknown model 'GPT'" in pg.evaluate(ask, {"model": "GPT", "signal": "execute", "episode": episode})
     assert pg.evaluate(ask, {"model": "PGAE", "signal": "dance", "episode": episode}) == (
         "unknown signal 'dance'; the signals are: describe, execute, repeat action, repeat both, repeat language")
-    assert "no test episode 'sim/999-9'" in pg.evaluate(ask, {"model": "PGAE", "signal": "execute",
-                                                             "episode": "sim/999-9"})
+    assert "no episode 'sim/999-9' in this page" in pg.evaluate(ask, {"model": "PGAE", "signal": "execute",
+                                                                     "episode": "sim/999-9"})
 
 
 def test_the_widget_runs_in_the_page(page):

@@ -310,3 +310,37 @@ def test_bad_text_shows_a_friendly_message_and_no_traceback(tiny, toy):
     ui.button.click()
     assert ui.message == "" and ui.result.pattern == pattern_for("pull yellow slowly", ARRANGEMENT)
     assert len(ui.output.outputs) == 2 and "Cannot run this" not in _html(ui.output)
+
+
+def test_word_choices_say_how_sure_the_decoder_was_of_each_word():
+    from pgae_lite.robot.play_result import choices_text, word_choices
+    from pgae_lite.world.words import VOCABULARY, WORD_INDEX
+
+    logits = torch.full((4, len(VOCABULARY)), -10.0)
+    logits[0, WORD_INDEX["push"]], logits[0, WORD_INDEX["pull"]] = 5.0, 4.0      # push, pull the runner-up
+    logits[1, 0] = 3.0                                                              # then <BOS/EOS>: the words end
+    choices = word_choices(logits)
+    assert [c["word"] for c in choices] == ["push", VOCABULARY[0]] and choices[0]["runner_up"] == "pull"
+    e = np.exp([5.0, 4.0] + [-10.0] * (len(VOCABULARY) - 2))
+    assert abs(choices[0]["p"] - e[0] / e.sum()) < 1e-12 and abs(choices[0]["runner_up_p"] - e[1] / e.sum()) < 1e-12
+    assert choices_text(choices).startswith("push 0.73 (pull 0.27)")
+
+
+def test_each_model_has_its_route_for_free_text_from_its_recipe(toy):
+    from pgae_lite.config import get_profile
+    from pgae_lite.robot.instructions import default_route
+    from pgae_lite.runs.rows import TRAININGS
+
+    book = get_profile("book")
+    assert [default_route(TRAININGS[n].profile(book)) for n in ("PGAE", "PGAE-BERT", "PGAE-BERT-phrasings")] == \
+        [None, "direct", "said back"]
+    # the widget's "act on" menu follows the model chosen
+    lstm = PGAE(ModelConfig(units=16, hidden=8, joint_feedback="predicted")).eval()
+    other = PGAE(ModelConfig(units=16, hidden=8, joint_feedback="predicted")).eval()
+    normaliser = Normaliser.fit(toy.split("train"))
+    ui = Playground({"A": (lstm, normaliser), "B": (other, normaliser)}, None, toy, routes={"A": "said back"})
+    assert ui.route.value == "said back"
+    ui.model.value = "B"
+    assert ui.route.value == "direct"
+    with pytest.raises(ValueError, match="unknown route 'both'"):
+        Playground({"A": (lstm, normaliser)}, None, toy, routes={"A": "both"})

@@ -16,6 +16,7 @@ from pgae_lite.config import get_profile
 from pgae_lite.freeform.paraphrases import Paraphrase, load_paraphrases
 from pgae_lite.freeform.phrase_lexicon import training_lexicon
 from pgae_lite.freeform.phrasings import phrasings
+from pgae_lite.freeform.refusal_cases import NOT_REFUSED, REFUSED, SCENE, refusal_cases
 from pgae_lite.freeform.refusals import CannotDo, check_instruction, disagreement, refusal
 from pgae_lite.freeform.word_lookup import WordLookup
 from pgae_lite.robot.closedloop import closed_loop
@@ -31,49 +32,28 @@ class Plain:
     word_lookup = None
 
 
-SCENE = ("red", "blue")
+CASES = refusal_cases()
 
 
-@pytest.mark.parametrize("text, says", [
-    ("don't push the red cube", "what not to do"),
-    ("do not push the red cube, leave it alone", "what not to do"),
-    ("Please never slide the blue block", "what not to do"),
-    ("stop pulling the red cube", "what not to do"),
-    ("push the red cube slowly and then pull the blue cube fast", "one instruction at a time"),
-    ("push the red cube. After that push it again", "one instruction at a time"),
-    ("push the red cube and the blue cube", "2 cubes"),
-    ("push the red cube slowly and fast", "2 speeds"),
-    ("push the green cube slowly", "there is no green cube here"),
-    ("push the orange cube", "I know no orange cube"),
-    ("push the black cube", "I know no black cube"),
-    ("rotate the red cube", "I can't 'rotate' a cube"),
-    ("the red cube, please", "I can push"),
-])
-def test_refused_with_the_reason(text, says):
-    with pytest.raises(CannotDo, match=says):
-        check_instruction(text, Plain(), SCENE)
-    assert isinstance(CannotDo("x"), LanguageError)           # the playground shows it as a message
+def test_the_cases_cover_the_explicit_lists_the_paraphrases_and_the_training_phrasings():
+    texts = {case["text"] for case in CASES}
+    assert {text for text, _ in REFUSED} | set(NOT_REFUSED) <= texts
+    assert {p.text for p in load_paraphrases()} <= texts
+    assert phrasings("slide", "cyan", "fast", 4, seed=1)[0] in texts
+    assert all(set(case) == {"text", "scene", "understood", "says"} for case in CASES)
+    assert refusal_cases() == CASES                                       # the same cases, in the same order
 
 
-@pytest.mark.parametrize("text", [
-    "push the red cube, no rush",                             # a negated manner is no negation of the act
-    "Please move the azure box away without hurrying",
-    "push the red cube slowly, not fast",
-    "go ahead and pull the red cube quickly",                 # a frame's "and" is not a second step
-    "Carefully and slowly nudge the scarlet cube away from yourself",
-])
-def test_not_refused(text):
-    assert refusal(text, Plain(), SCENE) is None
-
-
-def test_no_paraphrase_or_training_sentence_is_refused_in_a_scene_with_its_cube():
-    scenes = {c: [a for a in ARRANGEMENTS if c in a] for c in COLOURS}
-    for p in load_paraphrases():
-        for scene in scenes[p.meaning[1]]:
-            assert refusal(p.text, Plain(), scene) is None, (p.text, scene)
-    for action, colour, speed in itertools.product(("push", "pull", "slide"), COLOURS, ("slowly", "fast")):
-        for text in phrasings(action, colour, speed, 4, seed=1):
-            assert refusal(text, Plain(), scenes[colour][0]) is None, text
+@pytest.mark.parametrize("case", CASES, ids=[f"{i}-{c['text'][:40]}" for i, c in enumerate(CASES)])
+def test_each_case_is_refused_with_its_reason_or_acted_on(case):
+    scene = None if case["scene"] is None else tuple(case["scene"])
+    if case["says"] is None:
+        assert refusal(case["text"], Plain(), scene, case["understood"]) is None, (case["text"], scene)
+    else:
+        with pytest.raises(CannotDo) as refused:
+            check_instruction(case["text"], Plain(), scene, case["understood"])
+        assert case["says"] in str(refused.value)
+        assert isinstance(refused.value, LanguageError)                  # the playground shows it as a message
 
 
 def test_a_word_the_model_looks_up_is_judged_as_it_reads_it():
@@ -83,16 +63,6 @@ def test_a_word_the_model_looks_up_is_judged_as_it_reads_it():
     said = refusal("push the orange cube", Looked(), SCENE)
     assert "there is no yellow cube here (I read 'orange' as yellow)" in said
     assert refusal("push the crimson cube", Looked(), SCENE) is None
-
-
-def test_without_a_scene_only_the_words_are_judged():
-    assert refusal("push the green cube slowly", Plain()) is None
-    assert "what not to do" in refusal("don't push the green cube", Plain())
-
-
-def test_the_readback_is_judged_only_where_the_words_name_no_colour():
-    assert "I understood 'push yellow fast'" in refusal("shove the thing away fast", Plain(), SCENE, "push yellow fast")
-    assert refusal("push the red cube fast", Plain(), SCENE, "push yellow fast") is None
 
 
 def test_disagreement_says_what_the_text_asks_and_what_was_chosen():

@@ -126,10 +126,10 @@ def test_the_cubes_say_what_the_simulator_said(written):
 def test_the_cubes_start_where_the_manifest_says(written, smoke):
     from pgae_lite.runs.pipeline import trained_model
     from pgae_lite.runs.rows import TRAININGS
-    from pgae_lite.web.assets import _episodes
+    from pgae_lite.web.episodes import episode_index
 
     normaliser = trained_model(TRAININGS["PGAE"], get_profile("smoke"), 0, device="cpu", progress=False).normaliser
-    _, index = _episodes(smoke, normaliser, SMOKE)        # manifest["episodes"], without the ONNX
+    _, index = episode_index(smoke, list(range(len(smoke))), "test", normaliser, SMOKE)   # manifest["episodes"]
     where = {e["id"]: e["cubes"] for e in index}
     for run in written[0]["runs"]:
         assert np.allclose(np.array(run["cubes"][0])[:, :2], where[run["episode"]], atol=1e-4), run["episode"]

@@ -1,12 +1,19 @@
 // What the robot will not do with a free instruction, and says instead, in the reader's page
 // (not in the paper). The rule of pgae_lite/freeform/refusals.py, line for line, on the data the
-// build writes for it (pgae_lite/web/refusal_data.py): the phrase lexicon's tables, and WordNet's
-// colour words and verbs. pgae.js loads this file with the sentence encoder, on the first free
-// text, and calls window.pgaeRefusals.make(shared, pyrepr) once:
+// build writes for it (pgae_lite/web/refusal_data.py): the phrase lexicon's tables, WordNet's
+// colour words and verbs, the world's colours and what the robot can do. pgae.js loads this file
+// with the sentence encoder, on the first free text, and calls window.pgaeRefusals.make(shared, logic)
+// once:
 //
-//   reader(model's refusals.json) -> {refusal(text, read, swapped, scene, understood), disagreement}
+//   make(refusals.json, logic) -> reader(model's refusals.json) -> {refusal(text, read, swapped, scene, understood)}
+//   disagreement(understood, chosen, logic)
 //
-// refusal returns the sentence Python's CannotDo carries, or null: the robot may act.
+// This file types no sentence: each one is a template of refusals.MESSAGES, which the build writes into
+// the manifest's messages (pgae_lite/web/messages.py) and Python formats its own from. logic.say(key,
+// fields) fills one (every {field} replaced by fields[field]; it throws if the key or a field is missing),
+// logic.pyrepr(s) is Python's repr of a string. Each field is handed as a string, already written, as
+// refusals.py hands it to str.format. refusal returns the sentence Python's CannotDo carries, or null:
+// the robot may act.
 (function () {
   "use strict";
 
@@ -48,11 +55,12 @@
     return found;
   }
 
-  function make(shared, pyrepr) {
+  function make(shared, logic) {
     const negators = new Set(shared.negators), colourWords = new Set(shared.colour_words);
     const verbs = words(shared.verbs), colours = shared.colours;
+    const say = (key, fields) => logic.say(key, fields), pyrepr = (s) => logic.pyrepr(s);
     const clauseEnd = new RegExp(shared.clause_end, "i"), stepEnd = new RegExp(shared.step_end, "i");
-    const sceneText = (scene) => `the cubes here are ${scene[0]} (left) and ${scene[1]} (right)`;
+    const sceneText = (scene) => say("scene", {left: scene[0], right: scene[1]});
 
     return function reader(model) {
       const full = table(model.phrases), byVerbs = table(model.phrases_by_verbs), known = new Set(model.known);
@@ -72,26 +80,27 @@
 
       function moreThanOne(read, said, negatedSpeeds) {                   // refusals._more_than_one
         const speeds = said.speed.filter(s => !negatedSpeeds.includes(s));
-        for (const [slot, named] of [["action", slotMeanings(read, byVerbs).action], ["cube", said.colour],
-                                     ["speed", speeds]]) {
+        for (const [key, named] of [["several_actions", slotMeanings(read, byVerbs).action],
+                                    ["several_cubes", said.colour], ["several_speeds", speeds]]) {
           const each = unique(named);
-          if (each.length > 1) return `${each.length} ${slot}s (${each.join(", ")})`;
+          if (each.length > 1) return say(key, {count: String(each.length), named: each.join(", ")});
         }
         const steps = read.split(stepEnd).filter(step => slotMeanings(step, full).action.length);
-        return steps.length > 1 ? `${steps.length} steps` : null;
+        return steps.length > 1 ? say("several_steps", {count: String(steps.length)}) : null;
       }
 
       function outsideTheWorld(text, read, said, swapped, scene) {        // refusals._outside_the_world
         const outside = unique(wordsOf(text)).filter(w => !swapped.some(([raw]) => raw === w) && !isKnown(w) &&
                                                       !colours.includes(w) && /^[a-z]{3,}$/.test(w) && colourWords.has(w));
         if (outside.length) {
-          return `I know no ${outside[0]} cube: the cubes of this world are ${colours.slice(0, -1).join(", ")} or ` +
-                 `${colours[colours.length - 1]}` + (scene ? `, and ${sceneText(scene)}` : "");
+          const andScene = scene ? say("and_scene", {scene: sceneText(scene)}) : "";
+          return say("no_such_colour", {word: outside[0], colours: colours.slice(0, -1).join(", "),
+                                        last: colours[colours.length - 1], and_scene: andScene});
         }
         if (!said.action.length) {
           const named = unique(wordsOf(read)).filter(w => !isKnown(w) && verbs.has(w));
-          const what = named.length ? `'${named[0]}' a cube` : `do ${pyrepr(text.trim())}`;
-          return `I can't ${what}: I can ${shared.actions_said}`;
+          if (named.length) return say("cannot_verb", {verb: named[0], actions: shared.actions_said});
+          return say("cannot_do", {text: pyrepr(text.trim()), actions: shared.actions_said});
         }
         return null;
       }
@@ -100,14 +109,14 @@
         for (const colour of unique(said.colour)) {
           if (!scene.includes(colour)) {
             const hit = swapped.find(([, v]) => slotMeanings(v, full).colour.includes(colour));
-            const asRead = hit ? ` (I read '${hit[0]}' as ${colour})` : "";
-            return `there is no ${colour} cube here${asRead}: ${sceneText(scene)}`;
+            const asRead = hit ? say("as_read", {word: hit[0], colour}) : "";
+            return say("absent_cube", {colour, as_read: asRead, scene: sceneText(scene)});
           }
         }
         if (understood === null || said.colour.length) return null;
         const colour = understood.meaning ? understood.meaning[1] : null;  // the colour of the readback
         return colour === null || scene.includes(colour) ? null :
-          `I understood ${pyrepr(understood.words)}, but there is no ${colour} cube here: ${sceneText(scene)}`;
+          say("understood_absent", {understood: pyrepr(understood.words), colour, scene: sceneText(scene)});
       }
 
       // refusals.refusal: text as typed, read after the word lookup, swapped its [word, replacement]s,
@@ -115,13 +124,13 @@
       function refusal(text, read, swapped, scene, understood) {
         const [negations, negatedSpeeds] = negated(read);
         if (negations.length) {
-          return `I can't do ${pyrepr(text.trim())}: it says what not to do (${pyrepr(negations[0])}); tell me ` +
-                 `what to do, e.g. 'push the ${scene ? scene[0] : "red"} cube slowly'`;
+          return say("negation", {text: pyrepr(text.trim()), negation: pyrepr(negations[0]),
+                                  colour: scene ? scene[0] : colours[0]});
         }
         const said = slotMeanings(read, full);
         const several = moreThanOne(read, said, negatedSpeeds);
         if (several) {
-          return `one instruction at a time: ${pyrepr(text.trim())} asks for ${several}; tell me one action on one cube`;
+          return say("one_at_a_time", {text: pyrepr(text.trim()), several});
         }
         return outsideTheWorld(text, read, said, swapped, scene) ||
                (scene ? absentCube(said, swapped, scene, understood) : null);
@@ -131,13 +140,13 @@
   }
 
   // refusals.disagreement: the readback {words, meaning} against the chosen episode's meaning.
-  function disagreement(understood, chosen, pyrepr) {
-    const said = `the chosen episode is ${chosen.join(" ")}: the verdict is against the chosen episode`;
+  function disagreement(understood, chosen, logic) {
+    const said = logic.say("chosen_episode", {chosen: chosen.join(" ")});
     if (!understood.meaning) {
-      return `I could not say the text back as a description (${pyrepr(understood.words || "<EOS>")}); ${said}`;
+      return logic.say("no_readback", {words: logic.pyrepr(understood.words || "<EOS>"), chosen: said});
     }
     return understood.meaning.join(" ") === chosen.join(" ") ? null :
-      `the text asks for ${understood.meaning.join(" ")}, as I understood it, but ${said}`;
+      logic.say("asks_otherwise", {asked: understood.meaning.join(" "), chosen: said});
   }
 
   window.pgaeRefusals = {make, disagreement, slotMeanings};

@@ -1,20 +1,21 @@
 // The live playground's controls and drawings (chapter 08): every element with class
-// "pgae-live" becomes a small form that calls window.pgae.run (pgae.js) and shows, computed in
-// the page, the words the model writes, what it understood of a typed text, its joints against
-// the target, the GMU gate, and NICO's arm in 3-D, animated through the joints the model wrote.
-// Nothing here computes the model or moves a cube: it only collects and draws. Cubes move only
-// along a closed-loop run that the pybullet simulator made at build time (pgae.simulated).
+// "pgae-live" becomes play's form (model, signal, cubes, action, variation, a text, the route)
+// that calls window.pgae.run (pgae.js) and shows what play shows, computed in the page: what the
+// model understood of a typed text, the words it wrote with the verdict and how sure it was of
+// each, its joints against the signal's target, the GMU gate, and NICO's arm in 3-D, drawn from
+// those joints by forward kinematics. Nothing here computes the model or moves a cube: it only
+// collects and draws. Cubes move only along the simulator's own closed-loop run of exactly this
+// model, episode and instruction, made when the book was built (result.simulated,
+// window.pgae.simulated); otherwise they stay where the recording had them. Every choice, label and
+// constant of Python's comes from the manifest (manifest.play).
 (function () {
   "use strict";
   const COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd"];   // one per joint
-  const SIGNALS = ["execute", "describe", "repeat action", "repeat language"];
-  const ROBOT_RATE = 80;     // recorded steps per second of robot time (pgae_lite.sim.record.SimConfig)
-  const PLAY_RATE = 20;      // steps per second on screen: a quarter of the robot's speed
+  const PLAY_RATE = 20;      // steps per second on screen
+  const UNSURE = 0.5;        // a word chosen with a lower probability is flagged as a guess
   const CENTRE = [0.15, 0.02, 0.05];                     // the point the 3-D view turns about (m)
   const VIEW = {az: 2.2, el: 0.75, dist: 0.95};          // camera: azimuth, elevation (rad), distance (m):
                                                          // above and behind NICO's left (moving) shoulder
-  // NICO's torso, half see-through: pgae_lite.sim.robot.nico_urdf's box (centre, size) above the table top.
-  const BODY = [[[-0.04, 0, 0.09], [0.11, 0.17, 0.18]]];
 
   function element(tag, attrs = {}, ...children) {
     const e = document.createElement(tag);
@@ -22,18 +23,14 @@
     children.forEach(c => e.appendChild(typeof c === "string" ? document.createTextNode(c) : c));
     return e;
   }
-
-  function select(label, options) {
-    const s = element("select", {"aria-label": label});
-    options.forEach(([value, text]) => s.appendChild(element("option", {value, text})));
-    return s;
+  function fill(select, options) {                        // options: [value, text]
+    select.textContent = "";
+    options.forEach(([value, text]) => select.appendChild(element("option", {value: String(value), text})));
   }
-
-  // The target of a signal's joints (pgae_lite.robot.playground.TARGETS): the recording, or one pose held.
-  function target(recorded, signal) {
-    if (signal === "describe") return recorded.map(() => recorded[recorded.length - 1]);
-    if (signal === "repeat language") return recorded.map(() => recorded[0]);
-    return recorded;
+  // A control with its visible name above it; the control carries the same name for screen readers.
+  function field(name, control) {
+    control.setAttribute("aria-label", name);
+    return element("label", {class: "pgae-live-field"}, element("span", {class: "pgae-live-name", text: name}), control);
   }
 
   // A series (a list of poses, points, ...) at a fractional step t: linear between the two steps
@@ -46,35 +43,40 @@
 
   // The joints, model (dashed) against target (solid), with a cursor at step t.
   function plotJoints(canvas, joints, wanted, t) {
-    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, pad = 30;
+    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, left = 64, pad = 16, bottom = 40;
     const all = joints.concat(wanted).flat(), lo = Math.min(...all), hi = Math.max(...all) + 1e-9;
-    const x = (s) => pad + (W - 2 * pad) * s / Math.max(1, joints.length - 1);
-    const y = (v) => H - pad - (H - 2 * pad) * (v - lo) / (hi - lo);
+    const x = (s) => left + (W - left - pad) * s / Math.max(1, joints.length - 1);
+    const y = (v) => H - bottom - (H - bottom - pad) * (v - lo) / (hi - lo);
     g.clearRect(0, 0, W, H);
-    g.strokeStyle = "#999"; g.strokeRect(pad, pad, W - 2 * pad, H - 2 * pad);
-    g.fillStyle = "#333"; g.font = "11px sans-serif";
-    g.fillText("joints (rad): model (dashed) and target (solid), by step", pad, pad - 8);
+    g.strokeStyle = "#999"; g.lineWidth = 1; g.strokeRect(left, pad, W - left - pad, H - bottom - pad);
+    g.fillStyle = "#333"; g.font = "22px sans-serif"; g.textAlign = "right";
+    [lo, (lo + hi) / 2, hi].forEach(v => g.fillText(v.toFixed(1), left - 8, y(v) + 8));
+    g.textAlign = "center";
+    [0, joints.length - 1].forEach(s => g.fillText(String(s), x(s), H - bottom + 28));
+    g.fillText("step", (left + W - pad) / 2, H - bottom + 28);
+    g.textAlign = "left"; g.lineWidth = 2;
     for (let j = 0; j < 5; j++) {
-      [[wanted, []], [joints, [5, 4]]].forEach(([series, dash]) => {
+      [[wanted, []], [joints, [8, 6]]].forEach(([series, dash]) => {
         g.setLineDash(dash); g.strokeStyle = COLOURS[j]; g.beginPath();
         series.forEach((pose, s) => (s ? g.lineTo(x(s), y(pose[j])) : g.moveTo(x(s), y(pose[j]))));
         g.stroke();
       });
     }
-    g.setLineDash([]); g.strokeStyle = "#555";
-    g.beginPath(); g.moveTo(x(t), pad); g.lineTo(x(t), H - pad); g.stroke();
+    g.setLineDash([]); g.strokeStyle = "#555"; g.lineWidth = 1.5;
+    g.beginPath(); g.moveTo(x(t), pad); g.lineTo(x(t), H - bottom); g.stroke();
   }
 
   function plotGate(canvas, gate) {
-    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, pad = 20, w = (W - 2 * pad) / gate.length;
+    const g = canvas.getContext("2d"), W = canvas.width, H = canvas.height, pad = 12, w = (W - 2 * pad) / gate.length;
+    const mean = gate.reduce((a, b) => a + b, 0) / gate.length, y = (z) => H - pad - (H - 2 * pad) * z;
     g.clearRect(0, 0, W, H);
-    g.fillStyle = "#333"; g.font = "11px sans-serif";
-    const mean = gate.reduce((a, b) => a + b, 0) / gate.length;
-    g.fillText(`GMU gate z per dimension of h, mean ${mean.toFixed(2)} (0 language, 1 action)`, pad, 12);
+    g.strokeStyle = "#bbb"; g.lineWidth = 1; g.strokeRect(pad, pad, W - 2 * pad, H - 2 * pad);
     gate.forEach((z, k) => {
       g.fillStyle = `rgb(${Math.round(255 * z)}, 80, ${Math.round(255 * (1 - z))})`;
-      g.fillRect(pad + k * w, H - pad - (H - 2 * pad - 10) * z, Math.max(1, w - 1), (H - 2 * pad - 10) * z);
+      g.fillRect(pad + k * w, y(z), Math.max(1, w - 1), (H - 2 * pad) * z);
     });
+    g.setLineDash([4, 4]); g.strokeStyle = "#000";
+    g.beginPath(); g.moveTo(pad, y(mean)); g.lineTo(W - pad, y(mean)); g.stroke(); g.setLineDash([]);
   }
 
   // ---- The 3-D view: NICO's frame (x forward, y to NICO's left, z up; the table top is z = 0),
@@ -117,7 +119,7 @@
     });
   }
 
-  // One frame: the table, shadows, fingertip paths, then cubes and arms far to near.
+  // One frame: the table, shadows, fingertip paths, then cubes, NICO's torso and arms far to near.
   function drawScene(canvas, view, s, t) {
     const m = window.pgae.manifest(), a = m.arm, g = canvas.getContext("2d"), W = canvas.width, H = canvas.height;
     const cam = camera(view, W, H), P = cam.project, [x0, x1] = a.table_x, w = a.table_half_width;
@@ -129,93 +131,144 @@
     [arm, simArm].filter(Boolean).forEach(q =>                            // shadows, straight down
       polyline(g, P, window.pgae.fk(q).map(p => [p[0], p[1], 0]),
                {strokeStyle: "rgba(0,0,0,0.15)", lineWidth: 6, lineCap: "round"}));
-    polyline(g, P, s.wanted.map(tip), {strokeStyle: "#888", lineWidth: 1});
-    polyline(g, P, s.joints.map(tip), {strokeStyle: "#1f77b4", lineWidth: 1, dash: [5, 4]});
+    polyline(g, P, s.wanted.map(tip), {strokeStyle: "#888", lineWidth: 1.5});
+    polyline(g, P, s.joints.map(tip), {strokeStyle: "#1f77b4", lineWidth: 1.5, dash: [6, 5]});
     const cubes = s.sim ? at(s.sim.cubes, t) : s.episode.cubes.map(([x, y]) => [x, y, a.cube_size / 2]);
     const items = cubes.map((c, k) => ({depth: P(c)[2], draw: () =>
       box(g, cam, c, [a.cube_size, a.cube_size, a.cube_size], m.cube_rgba[s.episode.scene[k]])}));
-    BODY.forEach(([c, size]) => items.push({depth: P(c)[2], draw: () => box(g, cam, c, size, [0.85, 0.86, 0.9, 0.55])}));
+    const [torsoCentre, torsoSize] = m.play.torso;                         // NICO's torso above the table, see-through
+    items.push({depth: P(torsoCentre)[2], draw: () => box(g, cam, torsoCentre, torsoSize, [0.85, 0.86, 0.9, 0.55])});
     const limb = (q, style) => window.pgae.fk(q).slice(1).forEach((p, k, ps) => {
       const from = k ? ps[k - 1] : window.pgae.fk(q)[0];
       items.push({depth: P(lerp(from, p, 0.5))[2], draw: () => polyline(g, P, [from, p], style)});
     });
-    if (simArm) limb(simArm, {strokeStyle: "rgba(90,90,90,0.9)", lineWidth: 4, lineCap: "round", dash: [6, 5]});
-    limb(arm, {strokeStyle: "#1f77b4", lineWidth: 7, lineCap: "round"});
+    if (simArm) limb(simArm, {strokeStyle: "rgba(90,90,90,0.9)", lineWidth: 5, lineCap: "round", dash: [8, 6]});
+    limb(arm, {strokeStyle: "#1f77b4", lineWidth: 9, lineCap: "round"});
     items.sort((p, q) => q.depth - p.depth).forEach(item => item.draw());
     const [tx, ty] = P(tip(arm));
-    g.fillStyle = "#0b3c66"; g.beginPath(); g.arc(tx, ty, 4, 0, 2 * Math.PI); g.fill();
-    const label = (text, y, colour) => {                                  // text on a white band
-      g.font = "11px sans-serif"; g.fillStyle = "rgba(255,255,255,0.8)";
-      g.fillRect(3, y - 11, g.measureText(text).width + 6, 15); g.fillStyle = colour; g.fillText(text, 6, y);
-    };
-    label("NICO's arm from the model's joints (blue), drawn by forward kinematics; drag to turn", 14, "#333");
-    label("fingertip path: model (blue dashed), target (grey)", 28, "#333");
-    if (simArm) label("grey dashed arm: the simulator's measured arm in its build-time run", 42, "#333");
-    label(s.sim ? `cubes: the simulator's ${s.sim.kind} run at build time, not this page: ${s.sim.passed ? "passed" : "failed"}`
-                : "cubes: where the recording has them (they do not move in this page)",
-          H - 8, s.sim ? (s.sim.passed ? "#1a7f37" : "#b42318") : "#555");
+    g.fillStyle = "#0b3c66"; g.beginPath(); g.arc(tx, ty, 5, 0, 2 * Math.PI); g.fill();
   }
 
   window.pgaeWidget = async function (root) {
     root.textContent = "Loading the models (onnxruntime-web)...";
-    let manifest;
+    let manifest, L;
     try {
       manifest = await window.pgae.load();
+      L = window.pgae.logic();
     } catch (e) {
       root.textContent = `The live playground cannot start: ${e.message}`;
       return;
     }
-    const model = select("model", Object.keys(manifest.models).map(m => [m, m]));
-    const signal = select("signal", SIGNALS.map(s => [s, s]));
-    const episode = select("episode", manifest.episodes.map(e => [e.id, `${e.id}: ${e.description} ` +
-                                                                  `(${e.scene[0]} left, ${e.scene[1]} right)`]));
-    const text = element("input", {type: "text", size: "34", "aria-label": "text",
-                                   placeholder: "or type a description, e.g. push red slowly"});
+    const P = manifest.play, names = Object.keys(manifest.models), first = manifest.episodes[0];
+    const jointNames = P.joint_names || [0, 1, 2, 3, 4].map(j => `joint ${j + 1}`);
+    const say = (words) => (words ? L.pyrepr(words) : "<EOS> alone");
+
+    // ---- The form: play's choices.
+    const model = element("select"), signal = element("select"), cubes = element("select"),
+          action = element("select"), variation = element("select"), route = element("select");
+    fill(model, names.map(m => [m, m]));
+    fill(signal, P.signals.map(s => [s, s]));
+    fill(cubes, P.arrangements.map(a => [a.number, a.label]));
+    fill(action, P.actions.map(a => [a.number, a.label]));
+    fill(route, P.routes.map(r => [r, P.route_labels[r]]));             // Python's Playground's labels
+    cubes.value = String(first.arrangement); action.value = String(first.action);
+    signal.value = P.default_signal;                                       // play's default signal
+    const text = element("input", {type: "text", class: "pgae-live-text",
+                                   placeholder: "or type a description, e.g. push red slowly; PGAE-BERT: any sentence"});
     const button = element("button", {type: "button", class: "pgae-live-run", text: "Run"});
+    const routeField = field("act on", route), busy = element("span", {class: "pgae-live-busy", role: "status"});
+    const form = element("div", {class: "pgae-live-form"}, field("model", model), field("signal", signal),
+                         field("cubes", cubes), field("action", action), field("variation", variation),
+                         element("label", {class: "pgae-live-field pgae-live-wide"},
+                                 element("span", {class: "pgae-live-name", text: "text"}), text),
+                         routeField, element("span", {class: "pgae-live-go"}, button, busy));
+    text.setAttribute("aria-label", "text");
+    button.setAttribute("aria-label", "Run");
+
+    // The chosen pattern's recordings on this page: variation 0..n-1, each marked test or training.
+    const pattern = () => L.scenePattern(Number(cubes.value), Number(action.value));
+    const recordings = () => manifest.episodes.filter(e => e.pattern === pattern());
+    function fillVariations(keep) {
+      const mine = recordings();
+      fill(variation, mine.length ? mine.map((e, k) => [k, `${k} (${e.split === "test" ? "test" : "training"})`])
+                                  : [[0, "none on this page"]]);
+      variation.value = String(Math.min(keep, Math.max(0, mine.length - 1)));
+    }
+    fillVariations(recordings().indexOf(first));
+    const chosen = () => recordings()[Number(variation.value)] || null;
+    // The route: only for the models that have one (free text under execute), each model's own by default.
+    function showRoute() {
+      const own = manifest.models[model.value].route;
+      routeField.hidden = own === null || own === undefined;
+      if (!routeField.hidden) route.value = own;
+      route.disabled = signal.value !== P.route_signal;
+      route.title = route.disabled ? `used only under ${P.route_signal}` : "";
+    }
+    model.addEventListener("change", showRoute);
+    signal.addEventListener("change", () => { route.disabled = signal.value !== P.route_signal;
+                                              route.title = route.disabled ? `used only under ${P.route_signal}` : ""; });
+    showRoute();
+
+    // ---- What a run shows, hidden until one succeeds.
+    const error = element("p", {class: "pgae-live-error", role: "alert", hidden: ""});
+    const cameraBox = element("div", {class: "pgae-live-camera"});
     const said = element("pre", {class: "pgae-live-said"});
-    const camera = element("div", {class: "pgae-live-camera"});
-    // The animation's controls are <input>s, not <button>s: the Run button stays the widget's only <button>.
-    const play = element("input", {type: "button", class: "pgae-live-play", value: "Play", disabled: ""});
+    const sure = element("div", {class: "pgae-live-sure"});
+    const play = element("input", {type: "button", class: "pgae-live-play", value: "Play", "aria-label": "play or pause"});
     const slider = element("input", {type: "range", class: "pgae-live-time", min: "0", max: "0", value: "0",
-                                     disabled: "", "aria-label": "step"});
+                                     "aria-label": "step"});
     const clock = element("span", {class: "pgae-live-clock"});
-    const simBox = element("input", {type: "checkbox", checked: ""});
+    const simBox = element("input", {type: "checkbox", checked: "", "aria-label": "show the simulator's arm"});
     const simToggle = element("label", {class: "pgae-live-simarm", hidden: ""}, simBox, " show the simulator's arm");
     const arm = element("canvas", {width: "640", height: "380", class: "pgae-live-arm",
                                    "aria-label": "NICO's arm in 3-D, drag to turn"});
-    const note = element("p", {class: "pgae-live-cubes"});
-    const joints = element("canvas", {width: "640", height: "260"});
-    const gate = element("canvas", {width: "640", height: "120"});
+    const armKey = element("p", {class: "pgae-live-caption"});
+    const cubesNote = element("p", {class: "pgae-live-cubes"});
+    const joints = element("canvas", {width: "640", height: "300", class: "pgae-live-joints",
+                                      "aria-label": "the joints by step: model dashed, target solid"});
+    const jointsTitle = element("p", {class: "pgae-live-caption"});
+    const legend = element("div", {class: "pgae-live-legend"});
+    jointNames.forEach((name, j) => legend.appendChild(element("span", {},
+      element("span", {class: "pgae-live-swatch", style: `background: ${COLOURS[j]}`}), name)));
+    legend.appendChild(element("span", {}, element("span", {class: "pgae-live-line pgae-live-dashed"}), "model"));
+    legend.appendChild(element("span", {}, element("span", {class: "pgae-live-line"}), "target"));
+    const gate = element("canvas", {width: "640", height: "110", class: "pgae-live-gate",
+                                    "aria-label": "the GMU gate z per dimension of h"});
+    const gateTitle = element("p", {class: "pgae-live-caption"});
+    const result = element("div", {class: "pgae-live-result", hidden: ""}, said, sure, armKey, arm,
+                           element("div", {class: "pgae-live-controls"}, play, slider, clock, simToggle),
+                           cubesNote, jointsTitle, legend, joints, gateTitle, gate);
     root.textContent = "";
-    [model, signal, episode, text, button, camera, said, arm,
-     element("div", {}, play, " ", slider, " ", clock, " ", simToggle), note, joints, gate].forEach(c => root.appendChild(c));
-    arm.style.cursor = "grab"; arm.style.touchAction = "none"; arm.style.maxWidth = "100%";
-    slider.style.width = "240px"; note.style.fontSize = "0.9em";
+    [form, error, cameraBox, result].forEach(c => root.appendChild(c));
 
-    // NICO's camera in the chosen episode's recording (the build's PNGs), first and last step.
-    function showCamera() {
-      camera.textContent = "";
-      if (!window.pgae.frame(episode.value, "first")) return;
-      ["first", "last"].forEach(which => camera.appendChild(element("img", {
-        src: window.pgae.frame(episode.value, which), width: "160", height: "120",
-        alt: `NICO's camera at the ${which} step of ${episode.value}`, style: "margin-right: 4px"})));
-      camera.appendChild(element("div", {style: "font-size: 0.85em",
-        text: "NICO's camera in this episode's recording, first and last step (what the CAE read, not this page)"}));
+    // NICO's camera in an episode's recording (the build's PNGs), first and last step.
+    function showCamera(ep) {
+      cameraBox.textContent = "";
+      if (!ep || !window.pgae.frame(ep.id, "first")) return;
+      const frames = element("div", {class: "pgae-live-frames"});
+      ["first", "last"].forEach(which => frames.appendChild(element("img", {
+        src: window.pgae.frame(ep.id, which), width: "160", height: "120",
+        alt: `NICO's camera at the ${which} step of ${ep.id}`})));
+      cameraBox.append(frames, element("div", {class: "pgae-live-caption",
+        text: `NICO's camera in the recording of ${ep.id} (${ep.split === "test" ? "test" : "training"}): ` +
+              `${ep.description}, first and last step (what the model sees, not drawn by this page)`}));
     }
-    episode.addEventListener("change", showCamera);
-    showCamera();
+    const formChanged = () => { if (!running) showCamera(chosen()); };
+    [cubes, action].forEach(c => c.addEventListener("change", () => { fillVariations(0); formChanged(); }));
+    variation.addEventListener("change", formChanged);
+    showCamera(chosen());
 
     // What is drawn: s (the run, its target, the episode, the simulator's run or null) at step t.
     const view = {...VIEW};
-    let s = null, t = 0, playing = 0, last = null;
+    let s = null, t = 0, playing = 0, last = null, running = false;
     const steps = () => Math.max(s.joints.length, s.sim ? s.sim.cubes.length : 0);
     function redraw() {
       if (!s) return;
       drawScene(arm, view, s, t);
       plotJoints(joints, s.joints, s.wanted, Math.min(t, s.joints.length - 1));
       slider.value = String(Math.round(t));
-      clock.textContent = `step ${Math.round(t)} of ${steps() - 1} · ${(t / ROBOT_RATE).toFixed(2)} s of robot time ` +
-                          `· played ${ROBOT_RATE / PLAY_RATE}× slower`;
+      clock.textContent = `step ${Math.round(t)} of ${steps() - 1} · ${(t / P.robot_rate).toFixed(2)} s of robot time ` +
+                          `· played ${+(P.robot_rate / PLAY_RATE).toFixed(1)}× slower`;
     }
     // requestAnimationFrame loop; each Play starts a new one and stops the ones before it.
     function setPlaying(on) {
@@ -231,60 +284,140 @@
       if (on) requestAnimationFrame(frame);
     }
     play.addEventListener("click", () => {
+      if (!s) return;
       if (playing) return setPlaying(false);
       if (t >= steps() - 1) t = 0;                                        // at the end: from the start again
       setPlaying(true);
     });
     slider.addEventListener("input", () => { setPlaying(false); t = Number(slider.value); redraw(); });
     simBox.addEventListener("change", () => { if (s) s.showSim = simBox.checked; redraw(); });
-    let drag = null;                                                      // turn the view by dragging
+    // Turn the view by dragging: a drag across the whole canvas, as it is shown, turns it 1.5 pi.
+    let drag = null;
     arm.addEventListener("pointerdown", (e) => { drag = [e.clientX, e.clientY]; arm.setPointerCapture(e.pointerId); });
     ["pointerup", "pointercancel"].forEach(k => arm.addEventListener(k, () => { drag = null; }));
     arm.addEventListener("pointermove", (e) => {
       if (!drag) return;
-      view.az -= (e.clientX - drag[0]) * 0.01;
-      view.el = Math.max(0.05, Math.min(1.5, view.el + (e.clientY - drag[1]) * 0.01));
+      const shown = arm.getBoundingClientRect(), turn = 1.5 * Math.PI;
+      view.az -= (e.clientX - drag[0]) / shown.width * turn;
+      view.el = Math.max(0.05, Math.min(1.5, view.el + (e.clientY - drag[1]) / shown.width * turn));
       drag = [e.clientX, e.clientY]; redraw();
     });
 
-    button.addEventListener("click", async () => {
-      button.disabled = true;
+    // How sure the decoder was of each word it wrote: word, p, runner-up, its p; a low p flagged.
+    function sureTable(caption, choices) {
+      const table = element("table", {class: "pgae-live-choices"}, element("caption", {text: caption}));
+      table.appendChild(element("tr", {}, ...["#", "word", "p", "runner-up", "p"].map(h => element("th", {text: h}))));
+      choices.forEach((c, k) => {
+        const guess = c.p < UNSURE, cell = element("td", {text: c.p.toFixed(2)});
+        if (guess) cell.appendChild(element("span", {class: "pgae-live-guess-tag", text: " a guess"}));
+        table.appendChild(element("tr", guess ? {class: "pgae-live-guess"} : {},
+          element("td", {text: String(k + 1)}), element("td", {text: c.word}), cell,
+          element("td", {text: c.runner_up}), element("td", {text: c.runner_up_p.toFixed(2)})));
+      });
+      return element("div", {class: "pgae-live-table"}, table);
+    }
+    const lowest = (choices) => choices.reduce((a, c) => (c.p < a.p ? c : a), choices[0]);
+    function sureText(choices) {                                            // e.g. "lowest p 0.43 (red): a guess"
+      if (!choices || !choices.length) return "";
+      const low = lowest(choices);
+      return ` (how sure: lowest p ${low.p.toFixed(2)}, ${low.word}${low.p < UNSURE ? ": a guess" : ""})`;
+    }
+    const line = (...parts) => {                          // one line of the summary (a block: wraps indented)
+      const out = element("span", {class: "pgae-live-said-line"});
+      parts.forEach(p => out.appendChild(typeof p === "string" ? document.createTextNode(p) : p));
+      return out;
+    };
+
+    function showResult(r, ep, ms) {
+      said.textContent = "";
+      said.appendChild(line(`episode ${r.episode} (${r.split === "test" ? "test" : "training"}): ${ep.description} ` +
+                            `(${ep.scene[0]} left, ${ep.scene[1]} right); the model reads ${L.pyrepr(r.told)}`));
+      if (r.understood !== null) {
+        said.appendChild(line(`I understood: ${r.understood || "<EOS>"}`,
+                              element("span", {class: lowest(r.understood_choices || [{p: 1}]).p < UNSURE ?
+                                                 "pgae-live-unsure" : "pgae-live-quiet",
+                                               text: sureText(r.understood_choices)})));
+      }
+      if (r.note) said.appendChild(line(`note: ${r.note}`));
+      if (r.route === "said back" && r.acted_on !== null) said.appendChild(line(`acted on (${r.route}): ${L.pyrepr(r.acted_on)}`));
+      said.appendChild(r.correct
+        ? line(`words: ${say(r.words)} `, element("span", {class: "pgae-live-right", text: "right"}),
+               ` (${r.signal} asks for ${r.expected})`)
+        : line("words: ", element("span", {class: "pgae-live-wrong",
+               text: `wrong: wrote ${say(r.words)} where ${r.signal} asks for ${r.expected}`})));
+      const mean = r.gate.reduce((a, b) => a + b, 0) / r.gate.length;
+      said.appendChild(line(`joints: nRMSE ${r.nrmse.toFixed(2)}% of the joint range against ${P.targets[r.signal]}`));
+      said.appendChild(line(`mean gate z ${mean.toFixed(2)} (0 = language, 1 = action)`));
+      said.appendChild(line(`computed in this page in ${ms.toFixed(0)} ms`));
+
+      sure.textContent = "";
+      sure.appendChild(sureTable("how sure of each word it wrote", r.choices));
+      if (r.understood_choices) sure.appendChild(sureTable("how sure of each word it said back", r.understood_choices));
+      sure.appendChild(element("p", {class: "pgae-live-caption", text: `The decoder can only answer in the dataset's ` +
+        `${manifest.vocabulary.length - 1} words: its last layer scores those and nothing else, so any sentence ` +
+        "gets an answer; a low probability says it was a guess."}));
+
+      jointsTitle.textContent = `${r.signal}: the joints (rad) by step, the model's (dashed) against the target ` +
+                                `(solid), which is ${P.targets[r.signal]}`;
+      gateTitle.textContent = `GMU gate z per dimension of h, mean ${mean.toFixed(2)} (dotted line; 0 language, 1 action)`;
+      plotGate(gate, r.gate);
+    }
+
+    function clear() {                                                      // nothing stale stays drawn
       setPlaying(false);
-      said.classList.remove("pgae-live-error");
+      s = null;
+      result.hidden = true;
+      said.textContent = ""; sure.textContent = ""; cubesNote.textContent = "";
+      [arm, joints, gate].forEach(c => c.getContext("2d").clearRect(0, 0, c.width, c.height));
+    }
+
+    async function runIt() {
+      if (running) return;
+      running = true; button.disabled = true; busy.textContent = "computing...";
+      setPlaying(false);
+      delete root.dataset.result;
+      const args = {model: model.value, signal: signal.value, arrangement: Number(cubes.value),
+                    action: Number(action.value), variation: Number(variation.value), text: text.value};
+      if (!routeField.hidden) args.route = route.value;
       try {
         const t0 = performance.now();
-        const r = await window.pgae.run({model: model.value, signal: signal.value, episode: episode.value,
-                                         text: text.value});
-        said.textContent = (r.understood !== null ? `I understood: ${r.understood || "<EOS>"}\n` : "") +
-          (r.note ? `note: ${r.note}\n` : "") +
-          `words: ${r.words || "<EOS>"}\ncomputed in this page in ${(performance.now() - t0).toFixed(0)} ms`;
-        // The cubes move only along the simulator's own run of this model on this episode (execute).
-        let sim = null, why = "";
-        if (signal.value === "execute" && typeof window.pgae.simulated === "function") {
-          try { sim = await window.pgae.simulated(model.value, episode.value); }
-          catch (e) { why = ` (no simulator run: ${e.message})`; }
+        const r = await window.pgae.run(args), ms = performance.now() - t0;
+        const ep = manifest.episodes.find(e => e.id === r.episode);
+        // The cubes move only along the simulator's own build-time run of exactly this model, episode and instruction.
+        const sim = r.simulated ? await window.pgae.simulated(r.model, r.episode) : null;
+        error.hidden = true; error.textContent = "";
+        showResult(r, ep, ms);
+        showCamera(ep);
+        s = {joints: r.joints, wanted: r.target, episode: ep, sim, showSim: simBox.checked};
+        armKey.textContent = "NICO's arm from the model's joints (blue), drawn by forward kinematics; its fingertip's " +
+          "path: the model's (blue dashed), the target's (grey)" + (sim ? "; grey dashed arm: the simulator's measured " +
+          "arm in its build-time run" : "") + ". Drag to turn.";
+        cubesNote.textContent = "";
+        if (sim) {
+          cubesNote.append(`${sim.label} ${r.model}, told ${L.pyrepr(sim.description)} (${sim.kind}): `,
+                           element("strong", {class: sim.passed ? "pgae-live-right" : "pgae-live-wrong",
+                                              text: sim.passed ? "passed" : "failed"}),
+                           ". The cubes move as they moved in that run.");
+        } else {
+          cubesNote.textContent = "The simulator ran only when the book was built, and only for each test episode's " +
+            "own instruction; for this instruction the page shows what the model computed: its joints, and NICO's " +
+            "arm drawn from them by forward kinematics. The cubes stay where the recording had them.";
         }
-        const ep = manifest.episodes.find(e => e.id === episode.value);
-        s = {joints: r.joints, wanted: target(window.pgae.recorded(episode.value), signal.value), episode: ep,
-             sim, showSim: simBox.checked};
-        note.textContent = sim
-          ? `The cubes move as they moved in the simulator, not in this page. ${sim.label} ${model.value} was ` +
-            `told "${sim.description}" (${sim.kind}): ${sim.passed ? "passed" : "failed"} (the simulator's check: ` +
-            "did the named cube move the named way?). The grey dashed arm is that run's measured arm; the blue " +
-            "arm is this page's run, which reads the recorded camera frames instead, so the two can differ."
-          : "The cubes do not move in this page: they stay where the recording has them. Only the simulator " +
-            `moves them (chapter 07); this page computes the model, not the physics.${why}`;
         simToggle.hidden = !sim;
-        slider.max = String(steps() - 1); slider.disabled = false; play.disabled = false;
-        plotGate(gate, r.gate);
+        result.hidden = false;
+        slider.max = String(steps() - 1);
         t = 0; redraw(); setPlaying(true);
         root.dataset.result = JSON.stringify(r);
       } catch (e) {
-        said.textContent = `Cannot run this: ${e.message}`;
-        said.classList.add("pgae-live-error");
+        clear();
+        showCamera(chosen());
+        error.textContent = `Cannot run this: ${e.message}`;
+        error.hidden = false;
       } finally {
-        button.disabled = false;
+        running = false; button.disabled = false; busy.textContent = "";
       }
-    });
+    }
+    button.addEventListener("click", runIt);
+    text.addEventListener("keydown", (e) => { if (e.key === "Enter") runIt(); });
   };
 })();

@@ -9,4 +9,5 @@ Not in the paper, which says PGAE-BERT "has the potential to recognise unseen na
 - ``phrasing_bank``      training on phrasings: the bank of their sentence vectors; ``PhrasingsConfig``
 - ``paraphrases``        held-out free-form paraphrases of the test instructions
 - ``refusals``           what the robot will not do with a free instruction, and says instead
+- ``refusal_cases``      the refusal rule's test cases: for the unit tests, and the page's parity check
 """

@@ -47,7 +47,31 @@ SEQUENCERS = frozenset("then afterwards afterward later next finally also".split
 _CLAUSE_END = re.compile(r"[,.;:!?]|\b(?:and|but|or|then|while|before|after)\b", re.IGNORECASE)
 # A sentence or step ends at a full stop or semicolon, or where a sequencing word begins the next.
 _STEP_END = re.compile(r"[.;!?]|\b(?:" + "|".join(sorted(SEQUENCERS)) + r"|after that)\b", re.IGNORECASE)
+#: What the robot can do, as its refusals say it (the field ``actions`` of two messages).
 ACTIONS_SAID = "push (move up), pull (move down) or slide (move sideways) one cube"
+#: Every sentence of :func:`refusal` and :func:`disagreement`, as templates: ``str.format`` with named fields
+#: only, each filled with text already written (a repr where the sentence quotes). The page fills the same ones;
+#: a template that starts with a space or a comma is a part that another one's field takes, or leaves empty.
+MESSAGES: dict[str, str] = {
+    "scene": "the cubes here are {left} (left) and {right} (right)",
+    "negation": "I can't do {text}: it says what not to do ({negation}); tell me what to do, "
+                "e.g. 'push the {colour} cube slowly'",
+    "one_at_a_time": "one instruction at a time: {text} asks for {several}; tell me one action on one cube",
+    "several_actions": "{count} actions ({named})",
+    "several_cubes": "{count} cubes ({named})",
+    "several_speeds": "{count} speeds ({named})",
+    "several_steps": "{count} steps",
+    "no_such_colour": "I know no {word} cube: the cubes of this world are {colours} or {last}{and_scene}",
+    "and_scene": ", and {scene}",
+    "cannot_verb": "I can't '{verb}' a cube: I can {actions}",
+    "cannot_do": "I can't do {text}: I can {actions}",
+    "absent_cube": "there is no {colour} cube here{as_read}: {scene}",
+    "as_read": " (I read '{word}' as {colour})",
+    "understood_absent": "I understood {understood}, but there is no {colour} cube here: {scene}",
+    "chosen_episode": "the chosen episode is {chosen}: the verdict is against the chosen episode",
+    "no_readback": "I could not say the text back as a description ({words}); {chosen}",
+    "asks_otherwise": "the text asks for {asked}, as I understood it, but {chosen}",
+}
 
 
 class CannotDo(LanguageError):
@@ -106,7 +130,7 @@ def _negated(read: str, lexicon: PhraseLexicon) -> tuple[list[str], list[str]]:
 
 
 def _scene_text(scene: tuple[str, str]) -> str:
-    return f"the cubes here are {scene[0]} (left) and {scene[1]} (right)"
+    return MESSAGES["scene"].format(left=scene[0], right=scene[1])
 
 
 def _more_than_one(read: str, said: dict, lexicon: PhraseLexicon, negated_speeds: list[str]) -> str | None:
@@ -114,11 +138,11 @@ def _more_than_one(read: str, said: dict, lexicon: PhraseLexicon, negated_speeds
     # Actions are counted by their verbs: a direction word may be a manner ("drag it right away").
     by_verbs = slot_meanings(read, replace(lexicon, directions={a: () for a in lexicon.directions}))["action"]
     speeds = [s for s in said["speed"] if s not in negated_speeds]
-    for slot, named in (("action", by_verbs), ("cube", said["colour"]), ("speed", speeds)):
+    for key, named in (("several_actions", by_verbs), ("several_cubes", said["colour"]), ("several_speeds", speeds)):
         if len(set(named)) > 1:
-            return f"{len(set(named))} {slot}s ({', '.join(dict.fromkeys(named))})"
+            return MESSAGES[key].format(count=str(len(set(named))), named=", ".join(dict.fromkeys(named)))
     steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
-    return f"{len(steps)} steps" if len(steps) > 1 else None
+    return MESSAGES["several_steps"].format(count=str(len(steps))) if len(steps) > 1 else None
 
 
 def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swapped: dict[str, str],
@@ -127,12 +151,14 @@ def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swa
     outside = [w for w in dict.fromkeys(words_of(text)) if w not in swapped and not lookup.is_known(w)
                and w not in COLOURS and re.fullmatch(r"[a-z]{3,}", w) and is_colour_word(w)]
     if outside:
-        return (f"I know no {outside[0]} cube: the cubes of this world are {', '.join(COLOURS[:-1])} or "
-                f"{COLOURS[-1]}" + (f", and {_scene_text(scene)}" if scene else ""))
+        and_scene = MESSAGES["and_scene"].format(scene=_scene_text(scene)) if scene else ""
+        return MESSAGES["no_such_colour"].format(word=outside[0], colours=", ".join(COLOURS[:-1]), last=COLOURS[-1],
+                                                 and_scene=and_scene)
     if not said["action"]:
         verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w) and wordnet().synsets(w, pos="v")]
-        what = f"'{verbs[0]}' a cube" if verbs else f"do {text.strip()!r}"
-        return f"I can't {what}: I can {ACTIONS_SAID}"
+        if verbs:
+            return MESSAGES["cannot_verb"].format(verb=verbs[0], actions=ACTIONS_SAID)
+        return MESSAGES["cannot_do"].format(text=repr(text.strip()), actions=ACTIONS_SAID)
     return None
 
 
@@ -143,8 +169,8 @@ def _absent_cube(said: dict, lexicon: PhraseLexicon, swapped: dict[str, str], sc
     for colour in dict.fromkeys(named):
         if colour not in scene:
             word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
-            as_read = f" (I read '{word}' as {colour})" if word else ""
-            return f"there is no {colour} cube here{as_read}: {_scene_text(scene)}"
+            as_read = MESSAGES["as_read"].format(word=word, colour=colour) if word else ""
+            return MESSAGES["absent_cube"].format(colour=colour, as_read=as_read, scene=_scene_text(scene))
     if understood is None or named:
         return None
     try:                                                  # the colour came from the transformer alone
@@ -152,7 +178,7 @@ def _absent_cube(said: dict, lexicon: PhraseLexicon, swapped: dict[str, str], sc
     except LanguageError:
         return None
     return None if colour in scene else \
-        f"I understood {understood!r}, but there is no {colour} cube here: {_scene_text(scene)}"
+        MESSAGES["understood_absent"].format(understood=repr(understood), colour=colour, scene=_scene_text(scene))
 
 
 def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood: str | None = None) -> str | None:
@@ -165,12 +191,12 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
     lookup, read, swapped = _reading(encoder, text)
     negations, negated_speeds = _negated(read, lookup.lexicon)
     if negations:
-        return (f"I can't do {text.strip()!r}: it says what not to do ({negations[0]!r}); tell me what to do, "
-                f"e.g. 'push the {scene[0] if scene else 'red'} cube slowly'")
+        return MESSAGES["negation"].format(text=repr(text.strip()), negation=repr(negations[0]),
+                                           colour=scene[0] if scene else COLOURS[0])
     said = slot_meanings(read, lookup.lexicon)                         # the actions, cubes and speeds it names
     several = _more_than_one(read, said, lookup.lexicon, negated_speeds)
     if several:
-        return f"one instruction at a time: {text.strip()!r} asks for {several}; tell me one action on one cube"
+        return MESSAGES["one_at_a_time"].format(text=repr(text.strip()), several=several)
     outside = _outside_the_world(text, read, said, lookup, swapped, scene)
     if outside:
         return outside
@@ -180,13 +206,13 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
 def disagreement(understood: str | None, pattern: int) -> str | None:
     """A sentence saying that the model's readback of a text and the episode ``pattern`` disagree, or None."""
     p = Pattern.from_number(pattern)
-    chosen = f"the chosen episode is {p.action} {p.colour} {p.speed}: the verdict is against the chosen episode"
+    chosen = MESSAGES["chosen_episode"].format(chosen=f"{p.action} {p.colour} {p.speed}")
     try:
         meaning = parse_description(understood or "")
     except LanguageError:
-        return f"I could not say the text back as a description ({understood or '<EOS>'!r}); {chosen}"
+        return MESSAGES["no_readback"].format(words=repr(understood or "<EOS>"), chosen=chosen)
     if meaning != (p.action, p.colour, p.speed):
-        return f"the text asks for {' '.join(meaning)}, as I understood it, but {chosen}"
+        return MESSAGES["asks_otherwise"].format(asked=" ".join(meaning), chosen=chosen)
     return None
 
 
@@ -198,4 +224,5 @@ def check_instruction(text: str, encoder, scene: tuple[str, str] | None = None,
         raise CannotDo(reason)
 
 
-__all__ = ["ACTIONS_SAID", "NEGATORS", "SEQUENCERS", "CannotDo", "check_instruction", "disagreement", "refusal"]
+__all__ = ["ACTIONS_SAID", "MESSAGES", "NEGATORS", "SEQUENCERS", "CannotDo", "check_instruction", "disagreement",
+           "refusal"]

@@ -265,6 +265,12 @@ def success_summary(table: pd.DataFrame) -> pd.DataFrame:
         for name, g in groups]).set_index("group")
 
 
+#: The message of :func:`pattern_for`'s error as a template (``str.format``, named fields); the page fills it too.
+MESSAGES: dict[str, str] = {
+    "no_cube_in_arrangement": "there is no {colour} cube in arrangement {arrangement} ({left} left, {right} right)",
+}
+
+
 def pattern_for(description: str | tuple[str, str, str], arrangement: int) -> int:
     """The pattern a description asks for in cube arrangement ``arrangement`` (0-11, see ARRANGEMENTS).
 
@@ -273,7 +279,8 @@ def pattern_for(description: str | tuple[str, str, str], arrangement: int) -> in
     action, colour, speed = parse_description(description) if isinstance(description, str) else description
     left, right = ARRANGEMENTS[arrangement]
     if colour not in (left, right):
-        raise ValueError(f"there is no {colour} cube in arrangement {arrangement} ({left} left, {right} right)")
+        raise ValueError(MESSAGES["no_cube_in_arrangement"].format(colour=colour, arrangement=str(arrangement),
+                                                                   left=left, right=right))
     side = "L" if colour == left else "R"
     return pattern_number(("slowly", "fast").index(speed), arrangement, ACTION_SIDES.index((action, side)))
 

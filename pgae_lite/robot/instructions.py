@@ -60,12 +60,14 @@ def instruction_features(model: PGAE, texts: list[str]) -> torch.Tensor:
 
 
 ROUTES = ("direct", "said back")
+#: The message of :func:`check_route`'s error as a template (``str.format``, named fields); the page fills it too.
+MESSAGES: dict[str, str] = {"unknown_route": "unknown route {route}; the options are: {routes}"}
 
 
 def check_route(route: str) -> None:
     """A ValueError naming the routes unless ``route`` is one of ``ROUTES``."""
     if route not in ROUTES:
-        raise ValueError(f"unknown route {route!r}; the options are: {', '.join(map(repr, ROUTES))}")
+        raise ValueError(MESSAGES["unknown_route"].format(route=repr(route), routes=", ".join(map(repr, ROUTES))))
 
 
 @torch.no_grad()
@@ -94,6 +96,18 @@ def acted_on(said: list[str], texts: list[str]) -> list[str]:
         except LanguageError:
             out.append(text)
     return out
+
+
+def default_route(profile) -> str | None:
+    """The route free text takes under execute unless told otherwise, from the recipe ``profile`` the model
+    was trained with: ``"said back"`` for a model that read free text in training, but never under
+    execute (the free-form variant: it executes its own readback, which it was trained to write);
+    ``"direct"`` for one that reads free text otherwise (the paper's PGAE-BERT); None for a model that
+    reads no free text (PGAE's LSTM)."""
+    if profile.model.language is None:
+        return None
+    phrasings = profile.train.phrasings
+    return "said back" if phrasings is not None and "execute" not in phrasings.signals else "direct"
 
 
 def paraphrase_of(pattern: int, variation: int, paraphrases: list[Paraphrase]) -> Paraphrase | None:
@@ -167,5 +181,5 @@ def scene_of(pattern: int) -> tuple[str, str]:
     return p.left, p.right
 
 
-__all__ = ["ROUTES", "check_route", "instruction_features", "say_back", "acted_on", "paraphrase_of",
+__all__ = ["ROUTES", "check_route", "default_route", "instruction_features", "say_back", "acted_on", "paraphrase_of",
            "execute_paraphrases", "scene_of"]

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import matplotlib.pyplot as plt
 import numpy as np
+import torch
 from matplotlib.figure import Figure
 
 from pgae_lite.model.signals import LANG_OUT
@@ -20,12 +21,40 @@ from pgae_lite.sim.record import Execution
 from pgae_lite.util.checks import positive_number, whole_number
 from pgae_lite.viz import animate_frames, plot_joints
 from pgae_lite.world.patterns import Pattern
-from pgae_lite.world.words import SIGNALS
+from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 #: What the joints of each signal should be (the action decoder's target, from the recorded episode).
 TARGETS: dict[str, str] = {"describe": "the final recorded pose, held", "execute": "the recorded joints",
                            "repeat action": "the recorded joints", "repeat both": "the recorded joints",
                            "repeat language": "the first recorded pose, held"}
+
+#: What each signal asks the words to be (the paper's criterion, :func:`~pgae_lite.world.words.is_correct`).
+EXPECTED: dict[str, str] = {s: "a description of the action" if LANG_OUT[k] else "<EOS> alone"
+                            for k, s in enumerate(SIGNALS)}
+
+
+def word_choices(logits: torch.Tensor) -> list[dict]:
+    """How sure the language decoder was of each word it wrote, from its scores ``logits`` (steps, V).
+
+    Per position, up to and including the first ``<BOS/EOS>`` it chose: the word (the highest
+    probability, as greedy decoding picks it), its probability p = softmax(logits)[word], and the
+    runner-up word and its probability. The decoder can only answer in the dataset's words: its last
+    layer scores those 23 and nothing else, so even nonsense gets an answer; a low p says it was a guess.
+    """
+    p = torch.softmax(logits.detach().double().cpu(), -1)             # (steps, V), each row sums to 1
+    best = p.topk(2, -1)                                                # (steps, 2): values and indices
+    out = []
+    for k in range(p.shape[0]):
+        (first, second), (word, runner_up) = best.values[k].tolist(), best.indices[k].tolist()
+        out.append({"word": VOCABULARY[word], "p": first, "runner_up": VOCABULARY[runner_up], "runner_up_p": second})
+        if word == 0:                                                   # <BOS/EOS>: the words end here
+            break
+    return out
+
+
+def choices_text(choices: list[dict]) -> str:
+    """E.g. ``push 0.98 (pull 0.01), red 0.99 (...), ...``: each word, how sure, and its runner-up."""
+    return ", ".join(f"{c['word']} {c['p']:.2f} ({c['runner_up']} {c['runner_up_p']:.2f})" for c in choices)
 
 
 @dataclass
@@ -47,22 +76,30 @@ class PlayResult:
     loop: str | None = None   # "open", "closed" or None: how the simulator ran the joints
     understood: str | None = None  # typed text said back (``repeat language``): what the model took it to mean
     note: str | None = None   # where the typed text and the chosen episode disagree, that they do
+    choices: list[dict] | None = None   # how sure of each word written (word_choices)
+    understood_choices: list[dict] | None = None   # the same for the readback
+    route: str | None = None  # free text under execute: "direct" or "said back" (else None)
+    acted_on: str | None = None  # what route "said back" executed: the readback's words (or the text itself)
 
     def summary(self) -> str:
         """A few lines of plain text: task, episode, words, joint error, the simulator's verdict."""
         p = Pattern.from_number(self.pattern)
-        expected = LANG_OUT[SIGNALS.index(self.signal)]
         lines = [f"signal: {self.signal}   model reads: {self.told!r}",
                  f"episode {self.episode}: {p.action} the {p.colour} cube {p.speed} ({p.left} left, {p.right} right)",
                  f"words: {self.words or '<EOS>'!r} ({'right' if self.correct else 'wrong'}: expected "
-                 f"{'a description of the action' if expected else '<EOS> alone'})",
+                 f"{EXPECTED[self.signal]})",
                  f"joints: nRMSE {self.nrmse:.2f}% against {TARGETS[self.signal]}; "
                  f"mean gate z {self.gate.mean():.2f} (0 = language, 1 = action)"]
+        if self.choices:
+            lines.insert(3, f"how sure of each word: {choices_text(self.choices)}")
         if self.understood is not None:
             said = self.understood or "<EOS>"
-            lines.insert(1, f"I understood: {said} (the typed text said back with repeat language)")
+            sure = f"; how sure: {choices_text(self.understood_choices)}" if self.understood_choices else ""
+            lines.insert(1, f"I understood: {said} (the typed text said back with repeat language{sure})")
         if self.note:
             lines.insert(2, f"note: {self.note}")
+        if self.acted_on is not None:
+            lines.insert(2, f"acted on ({self.route}): {self.acted_on!r}")
         if self.rollout is not None:
             verdict = "the cube moved as told" if self.rollout.passed else f"failed ({self.rollout.check.reason})"
             held = self.signal in ("describe", "repeat language")
@@ -112,4 +149,4 @@ class PlayResult:
         display(*self.displays(every))
 
 
-__all__ = ["TARGETS", "PlayResult"]
+__all__ = ["EXPECTED", "TARGETS", "PlayResult", "choices_text", "word_choices"]

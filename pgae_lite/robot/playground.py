@@ -43,7 +43,7 @@ from pgae_lite.model.pgae import PGAE
 from pgae_lite.model.signals import LANG_IN, LANG_OUT, make_batch, signal_ids
 from pgae_lite.robot.closedloop import closed_loop, open_loop, pattern_for
 from pgae_lite.robot.instructions import acted_on, check_route
-from pgae_lite.robot.play_result import TARGETS, PlayResult
+from pgae_lite.robot.play_result import TARGETS, PlayResult, word_choices
 from pgae_lite.robot.playground_checks import (
     LAST_PATTERN,
     action_number,
@@ -68,6 +68,10 @@ from pgae_lite.world.words import (
 
 #: The signals the reader chooses from (``repeat both`` is for training only, but :func:`play` takes it).
 PLAY_SIGNALS: tuple[str, ...] = ("describe", "execute", "repeat action", "repeat language")
+#: What the "act on" menu calls each route of free text under execute (:mod:`pgae_lite.robot.instructions`).
+ROUTE_LABELS: dict[str, str] = {"said back": "what it said back", "direct": "the sentence"}
+#: The signal under which free text takes a route: the robot acts.
+ROUTE_SIGNAL = "execute"
 #: The 12 actions of an arrangement, (action, cube side, speed);
 #: action k is pattern 72·(k // 6) + 6·arrangement + k % 6.
 ACTIONS: tuple[tuple[str, str, str], ...] = tuple((a, side, speed) for speed in ("slowly", "fast")
@@ -97,6 +101,15 @@ def simulator_config(data: PGAEDataset) -> DatasetConfig:
     return next((p.data for p in PROFILES.values() if p.data.key() == key), PROFILES["book"].data)
 
 
+#: find_episode's messages (the page says them too: pgae_lite.web.messages). ``where``: "this dataset".
+MESSAGES = {
+    "no_recording": "{where} has no recording of {what}; its arrangements are: {arrangements}",
+    "no_variation": "{where} has {count} recording(s) of {what}, so no variation {variation} (count from 0)",
+    "pattern_named": "pattern {pattern} ({action} {colour} {speed}, {left} left, {right} right)",
+    "this_dataset": "this dataset",
+}
+
+
 def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[int, int]:
     """(row in ``data``, simulator variation) of the ``variation``-th recording of ``pattern``."""
     instance_of("data", data, PGAEDataset, "a PGAEDataset")
@@ -106,10 +119,12 @@ def find_episode(data: PGAEDataset, pattern: int, variation: int = 0) -> tuple[i
     if variation >= len(rows):
         p = Pattern.from_number(pattern)
         have = sorted({arrangement_label(pattern_parts(int(q))[1]) for q in data.pattern})
-        what = f"pattern {pattern} ({p.action} {p.colour} {p.speed}, {p.left} left, {p.right} right)"
-        raise ValueError(f"this dataset has no recording of {what}; its arrangements are: {'; '.join(have)}"
-                         if not len(rows) else f"this dataset has {len(rows)} recording(s) of {what}, "
-                         f"so no variation {variation} (count from 0)")
+        what = MESSAGES["pattern_named"].format(pattern=pattern, action=p.action, colour=p.colour, speed=p.speed,
+                                                left=p.left, right=p.right)
+        where = MESSAGES["this_dataset"]
+        raise ValueError(MESSAGES["no_recording"].format(where=where, what=what, arrangements="; ".join(have))
+                         if not len(rows) else MESSAGES["no_variation"].format(
+                             where=where, count=len(rows), what=what, variation=variation))
     row = int(rows[variation])
     name = str(data.ids[row])                                   # "sim/PPP-V" for our simulator's episodes
     return row, int(name.rsplit("-", 1)[1]) if name.startswith("sim/") else variation
@@ -157,19 +172,21 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
 
     model.eval()
     zero = torch.zeros(1, dtype=torch.long)
-    understood = None
+    understood = understood_choices = acted = None
     if reads_words and text:                               # readback: the same words, said back, no action shown
         back_language = typed.features("repeat language") if free else None
         back = model(make_batch(tensors, zero, signal_ids("repeat language", 1), zero), language=back_language)
         understood = decode(back["logits"][0].argmax(-1).cpu())
+        understood_choices = word_choices(back["logits"][0])
     note = None
     if free and signal == "execute":                      # the robot acts: first, whether it can (refusals.py)
         scene = Pattern.from_number(pattern)
         check_instruction(text, model.language_encoder, (scene.left, scene.right), understood)
         note = disagreement(understood, pattern)
     language = None
-    if free and route == "said back" and signal == "execute":   # act on its own words
-        said = acted_on([understood], [said])[0]
+    routed = route if free and signal == ROUTE_SIGNAL else None   # the route free text takes under execute
+    if routed == "said back":                              # act on its own words
+        said = acted = acted_on([understood], [said])[0]
         told = input_text(signal, said)
         language = model.language_encoder.encode_texts([told])
     elif free:
@@ -194,7 +211,8 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     nrmse = 100 * float(np.sqrt(np.mean((joints[1:] - target[1:]) ** 2))) / data.joint_range()
     return PlayResult(signal, pattern, sim_variation, str(data.ids[row]), told, generated,
                       is_correct(generated, expected if LANG_OUT[SIGNALS.index(signal)] else None),
-                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood, note)
+                      joints, target, nrmse, out["gate"][0].cpu().numpy(), rollout, loop, understood, note,
+                      word_choices(out["logits"][0]), understood_choices, routed, acted)
 
 
 class Playground:
@@ -205,12 +223,16 @@ class Playground:
     ``self.result``, the last error message in ``self.message``; the widgets
     are attributes (``signal``, ``arrangement``, ``action``, ``text``, ``button``,
     ``output``...), so a test can set them and call ``button.click()``.
-    ``signal``, ``arrangement`` and ``action`` are the first choices shown.
+    ``signal``, ``arrangement`` and ``action`` are the first choices shown. ``routes``: each model's
+    route for free text under execute (:func:`~pgae_lite.robot.instructions.default_route` of its recipe),
+    the "act on" menu's choice when that model is picked ("direct" for a model not named); without
+    ``routes`` the menu starts at "said back" and stays where the reader puts it.
     """
 
     def __init__(self, models: Mapping[str, tuple[PGAE, Normaliser]], cae: ChannelSeparatedCAE | None,
                  data: PGAEDataset, *, config: DatasetConfig | None = None, every: int = 4,
-                 signal: str = "execute", arrangement: int | None = None, action: int = 0):
+                 signal: str = "execute", arrangement: int | None = None, action: int = 0,
+                 routes: Mapping[str, str | None] | None = None):
         import ipywidgets as w
 
         check_playground(models, cae, data, config, every, signal, arrangement, action,
@@ -232,8 +254,18 @@ class Playground:
                            layout=w.Layout(width="32em"))
         self.loop = w.Dropdown(options=[("open loop", "open"), ("closed loop (execute)", "closed"), ("no robot", None)],
                                description="robot")
-        self.route = w.Dropdown(options=[("what it said back", "said back"), ("the sentence", "direct")],
+        self.route = w.Dropdown(options=[(label, route) for route, label in ROUTE_LABELS.items()],
                                 description="act on")            # free text under execute (PGAE-BERT)
+        self.routes = dict(routes or {})
+        for route in self.routes.values():
+            if route is not None:
+                check_route(route)
+
+        def follow(_change=None):                                # the model's own route when it is picked
+            self.route.value = self.routes.get(self.model.value) or "direct"
+        if routes is not None:
+            self.model.observe(follow, names="value")
+            follow()
         self.button = w.Button(description="Run", button_style="primary", icon="play")
         self.output = w.Output()
         self.button.on_click(self.run)
@@ -265,5 +297,6 @@ class Playground:
         return self.widget._repr_mimebundle_(**kwargs)
 
 
-__all__ = ["ACTIONS", "PLAY_SIGNALS", "TARGETS", "PlayResult", "Playground", "action_label", "arrangement_label",
-           "find_episode", "scene_pattern", "play", "simulator_config"]
+__all__ = [
+    "ACTIONS", "PLAY_SIGNALS", "ROUTE_LABELS", "ROUTE_SIGNAL", "TARGETS", "PlayResult", "Playground",
+    "action_label", "arrangement_label", "find_episode", "scene_pattern", "play", "simulator_config"]

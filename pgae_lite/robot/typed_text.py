@@ -23,6 +23,14 @@ from pgae_lite.bert.pretrained import input_text
 from pgae_lite.model.signals import LANG_IN
 from pgae_lite.world.words import SIGNALS, LanguageError, parse_description, tokenize
 
+#: This module's error messages as templates (``str.format``, named fields); the page fills the same ones.
+MESSAGES: dict[str, str] = {
+    "lstm_reads_vocabulary": "PGAE's LSTM reads only its vocabulary, in the order action colour speed "
+                             "(PGAE-BERT reads free text): {error}",
+    "signal_reads_no_words": "{signal} reads no words, so text can only pick the episode, and that takes "
+                             "a description: {error}",
+}
+
 
 @dataclass
 class TypedText:
@@ -60,11 +68,9 @@ def read_typed(encoder: nn.Module, signal: str, text: str) -> TypedText:
         words = tuple(tokenize(text))
     except LanguageError as e:
         if not encoder.reads_free_text:
-            raise LanguageError(f"PGAE's LSTM reads only its vocabulary, in the order action colour speed "
-                                f"(PGAE-BERT reads free text): {e}") from None
+            raise LanguageError(MESSAGES["lstm_reads_vocabulary"].format(error=str(e))) from None
         if not LANG_IN[SIGNALS.index(signal)]:
-            raise LanguageError(f"{signal!r} reads no words, so text can only pick the episode, and that takes "
-                                f"a description: {e}") from None
+            raise LanguageError(MESSAGES["signal_reads_no_words"].format(signal=repr(signal), error=str(e))) from None
         words = meaning = None
     return TypedText(text, encoder.read_as(text), words, meaning, encoder)
 

@@ -61,6 +61,7 @@ HAND_SIZE = (0.025, 0.045, HAND)       # thickness (x), width (y), length (z, al
 FINGERTIP = HAND - 0.012              # IK point: near the end of the hand, on its axis
 EYE = (0.035, 0.03, 0.385)            # left eye camera, robot frame
 EYE_PITCH = 0.90                      # camera looks down by this angle (rad, ~52 degrees)
+TORSO = ((0.11, 0.17, 0.30), (-0.04, 0, 0.03))   # the torso's box: size (x, y, z) and centre, robot frame
 
 WHITE = (0.92, 0.92, 0.90, 1.0)       # NICO's shell
 GREY = (0.45, 0.46, 0.50, 1.0)        # joints and torso
@@ -126,7 +127,7 @@ def nico_urdf() -> str:
             ("l_shoulder_cap", "box", (0.06, 0.05, 0.05), (sx, sy - 0.01, sz), GREY),
             ("r_shoulder_cap", "box", (0.06, 0.05, 0.05), (sx, -sy + 0.01, sz), GREY),
             ("r_arm", *_limb(LIMB_RADIUS, arm), (sx, -sy, sz - arm / 2), WHITE)]   # hangs still
-    links = [_link("torso", 0.0, "box", (0.11, 0.17, 0.30), (-0.04, 0, 0.03), WHITE)]
+    links = [_link("torso", 0.0, "box", *TORSO, WHITE)]
     joints = []
     for name, shape, size, xyz, rgba in body:
         links.append(_link(name, 0.01, shape, size, (0, 0, 0), rgba))

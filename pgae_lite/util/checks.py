@@ -17,6 +17,13 @@ from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
 MAX_SEED = 2 ** 32 - 1
 #: The device types the package runs on.
 DEVICE_TYPES = ("cpu", "cuda", "mps")
+#: :func:`whole_number`'s messages as templates (``str.format``, named fields); the page fills the same ones.
+MESSAGES: dict[str, str] = {
+    "whole_number_type": "{name} must be {allowed}; got {value} ({type})",
+    "whole_number_range": "{name} must be {allowed}; got {value}",
+    "whole_number_at_least": "a whole number >= {low}",
+    "whole_number_between": "a whole number from {low} to {high}",
+}
 
 
 def whole_number(name: str, value, low: int, high: int | None = None) -> int:
@@ -25,14 +32,14 @@ def whole_number(name: str, value, low: int, high: int | None = None) -> int:
     A bool, a float (even 3.0) or a string is refused with an ArgumentTypeError.
     """
     if high is None:
-        allowed = f"a whole number >= {low}"
+        allowed = MESSAGES["whole_number_at_least"].format(low=str(low))
     else:
-        allowed = f"a whole number from {low} to {high}"
+        allowed = MESSAGES["whole_number_between"].format(low=str(low), high=str(high))
     if isinstance(value, bool) or not isinstance(value, Integral):
-        raise ArgumentTypeError(f"{name} must be {allowed}; got {value!r} "
-                                f"({type(value).__name__})")
+        raise ArgumentTypeError(MESSAGES["whole_number_type"].format(name=name, allowed=allowed, value=repr(value),
+                                                                     type=type(value).__name__))
     if value < low or (high is not None and value > high):
-        raise ArgumentError(f"{name} must be {allowed}; got {value!r}")
+        raise ArgumentError(MESSAGES["whole_number_range"].format(name=name, allowed=allowed, value=repr(value)))
     return int(value)
 
 

@@ -1,6 +1,6 @@
 """What the live playground reads in the page, written at build time (not in the paper).
 
-Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes they run on.
+Paper, Sec. 3 and 4: the models of chapter 08's playground and the episodes they run on.
 :func:`export_web` writes, from the cache (no retraining when the chapters trained them)::
 
     models/NAME.onnx      each model's :class:`~pgae_lite.web.export.EpisodeGraph`
@@ -10,11 +10,14 @@ Paper, Sec. 3 and 4: the models of chapter 08's playground and the test episodes
     (free text)           PGAE-BERT's sentence encoder, word table and refusals (free_text.py)
     sim_runs.json         the simulator's closed-loop runs at build time (sim_runs.py), labelled so
     frames/PPP-V-first.png, frames/PPP-V-last.png
-                          NICO's camera in each test episode's recording, at its first and last step
+                          NICO's camera in each episode's recording, at its first and last step
                           (what the CAE read; the page shows them for the chosen episode)
     episodes.bin          every test episode, normalised as the model reads it, float32:
-                          action input (T, 35): [v_t; j_t] per step
-    manifest.json         the vocabulary, signals, models, the episodes' index (with where each
+                          action input (T, 35): [v_t; j_t] per step (episodes.py)
+    episodes-train.bin    the same for the first recording of each training pattern (fetched on demand)
+    parity.json           Python's answers to the page's inputs, for the tests (parity.py; not fetched)
+    manifest.json         the vocabulary, signals, messages (web/messages.py), the form's choices
+                          (episodes.play_choices), models, the episodes' index (with where each
                           episode's cubes lay), the normaliser's joint units, NICO's arm for forward
                           kinematics, and the file sizes
 
@@ -33,19 +36,20 @@ import torch
 
 from pgae_lite.bert.pretrained import fixed_token_rows, tokens_to_text
 from pgae_lite.config import Profile
-from pgae_lite.data.dataset import PGAEDataset
-from pgae_lite.data.normaliser import Normaliser
-from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, SIGNAL_TOKEN
+from pgae_lite.data.dataset import JOINT_DIM, VISION_DIM
+from pgae_lite.model.signals import ACTION_IN, EOS, LANG_IN, LANG_OUT, SIGNAL_TOKEN
+from pgae_lite.robot.instructions import default_route
 from pgae_lite.runs.data import SimulatedData, loaded, profile_of
 from pgae_lite.runs.pipeline import trained_model
 from pgae_lite.runs.rows import TRAININGS
-from pgae_lite.sim.record import scene_layout
 from pgae_lite.util.storage import atomic_write, atomic_write_text, make_folder
+from pgae_lite.web.episodes import FILES, episode_index, page_rows, play_choices
 from pgae_lite.web.export import to_onnx
 from pgae_lite.web.free_text import export_free_text
-from pgae_lite.web.sim_runs import simulator_runs
+from pgae_lite.web.messages import page_messages
+from pgae_lite.web.parity import write_parity
+from pgae_lite.web.sim_runs import chosen_episodes, simulator_runs
 from pgae_lite.world.colours import CUBE_RGBA
-from pgae_lite.world.patterns import Pattern
 from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY
 
 #: The models the playground offers, by the name the page shows, and their trainings.
@@ -62,50 +66,30 @@ def _arm() -> dict:
             "table_x": list(TABLE_X), "table_half_width": TABLE_HALF_WIDTH, "cube_size": CUBE_SIZE}
 
 
-def _episodes(test: PGAEDataset, normaliser: Normaliser, config) -> tuple[np.ndarray, list[dict]]:
-    """The test episodes as one float32 array and an index (offsets in floats)."""
-    tensors = normaliser.tensors(test)
-    vision, joints = tensors["vision"], tensors["joints"]                     # (N, T, 30), (N, T, 5)
-    chunks, index, at = [], [], 0
-    for i in range(len(test)):
-        n = int(test.lengths[i])
-        action = torch.cat([vision[i, :n], joints[i, :n]], 1).numpy().astype(np.float32)   # (n, 35)
-        p = Pattern.from_number(int(test.pattern[i]))
-        words = [VOCABULARY[w] for w in test.descriptions[i, 0] if w]            # its first description
-        variation = int(str(test.ids[i]).rsplit("-", 1)[1])                  # "sim/PPP-V"
-        layout = scene_layout(int(test.pattern[i]), variation, config.base_seed, config.sim)   # where the cubes lay
-        index.append({"id": str(test.ids[i]), "pattern": int(test.pattern[i]), "steps": n, "offset": at,
-                      "description": " ".join(words), "scene": [p.left, p.right],
-                      "meaning": [p.action, p.colour, p.speed],
-                      "cubes": [list(layout.left_xy), list(layout.right_xy)]})
-        chunks.append(action.ravel())
-        at += action.size
-    return np.concatenate(chunks), index
-
-
-def _frames(out: Path, test: PGAEDataset, config) -> str:
-    """NICO's recorded camera frames at the first and last step of every test episode, as PNG files; the
+def _frames(out: Path, episodes: list[dict], config) -> str:
+    """NICO's recorded camera frames at the first and last step of every episode of the page, as PNG files; the
     pattern of their names in ``out`` (``{episode}``: an id without ``sim/``; ``{which}``: first or last)."""
     from matplotlib.image import imsave
 
     from pgae_lite.sim.dataset import load_episode
 
     make_folder(out / "frames")
-    for sample, steps in zip(map(str, test.ids), test.lengths.tolist()):
-        name = sample.removeprefix("sim/")                                  # "PPP-V"
+    for episode in episodes:
+        name = episode["id"].removeprefix("sim/")                          # "PPP-V"
         pattern, variation = map(int, name.split("-"))
         images = load_episode(config, pattern, variation).images          # (T, 120, 160, 3) uint8
-        for which, frame in (("first", images[0]), ("last", images[int(steps) - 1])):
+        for which, frame in (("first", images[0]), ("last", images[episode["steps"] - 1])):
             with atomic_write(out / "frames" / f"{name}-{which}.png") as f:
                 imsave(f, frame, format="png")
     return "frames/{episode}-{which}.png"
 
 
 def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool = False,
-               simulate: bool = True, half: bool = True) -> dict:
+               simulate: bool = True, half: bool = True, parity: bool = True) -> dict:
     """Write the playground's models and episodes to ``out`` (see the module docstring); the manifest.
     ``simulate=False``: without the simulator's runs (the page then keeps the cubes where they lay);
-    ``half=False``: the sentence encoder's weights in float32 (:func:`~pgae_lite.web.free_text.export_free_text`)."""
+    ``half=False``: the sentence encoder's weights in float32 (:func:`~pgae_lite.web.free_text.export_free_text`);
+    ``parity=False``: without the parity vectors (:mod:`~pgae_lite.web.parity`)."""
     prof = profile_of(profile)
     out = make_folder(out)
     make_folder(out / "models")
@@ -124,7 +108,8 @@ def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool 
                              "one copy of the episodes, normalised once")
         normaliser = run.normaliser
         entry = {"file": f"models/{name}.onnx", "bytes": len(to_onnx(model, out / "models" / f"{name}.onnx")),
-                 "reads": "features" if model.language_encoder.reads_free_text else "tokens"}
+                 "reads": "features" if model.language_encoder.reads_free_text else "tokens",
+                 "route": default_route(run.profile)}          # free text under execute, unless the reader says
         if entry["reads"] == "features":
             with torch.no_grad():
                 table = model.language_encoder(rows).numpy().astype(np.float32)   # (rows, D)
@@ -134,24 +119,34 @@ def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool 
             encoders[name] = model.language_encoder
         models[name] = entry
     free_text = export_free_text(out, encoders, models, half) if encoders else None
-    values, episodes = _episodes(data.split("test"), normaliser, prof.data)
-    frames = _frames(out, data.split("test"), prof.data)
-    with atomic_write(out / "episodes.bin") as f:
-        f.write(values.tobytes())
+    episodes, files = [], {}
+    for split, chosen in page_rows(data).items():                     # every test episode, one per training pattern
+        values, index = episode_index(data, chosen, split, normaliser, prof.data)
+        with atomic_write(out / FILES[split]) as f:
+            f.write(values.tobytes())
+        episodes += index
+        files[split] = FILES[split]
+    frames = _frames(out, episodes, prof.data)
+    test = data.split("test")                                          # the simulator's runs: sim_runs.py
     manifest = {
         "profile": prof.name, "seed": seed, "vocabulary": list(VOCABULARY), "synonyms": SYNONYMS,
         "canonical": dict(DEFAULT_LEXICON.canonical), "slots": [list(slot) for slot in SLOTS],
         "slot_names": list(SLOT_NAMES), "signals": list(SIGNALS), "reads_words": [bool(x) for x in LANG_IN],
-        "sees_action": [bool(x) for x in ACTION_IN], "describe": SIGNALS.index("describe"),
-        "repeat_language": SIGNALS.index("repeat language"), "signal_token": SIGNAL_TOKEN, "eos": EOS,
-        "models": models, "episodes": episodes, "episodes_file": "episodes.bin", "joint_units": list(normaliser.joints),
+        "sees_action": [bool(x) for x in ACTION_IN], "lang_out": [bool(x) for x in LANG_OUT],
+        "describe": SIGNALS.index("describe"), "repeat_language": SIGNALS.index("repeat language"),
+        "signal_token": SIGNAL_TOKEN, "eos": EOS, "vision_dim": VISION_DIM, "joint_dim": JOINT_DIM,
+        "messages": page_messages(), "play": play_choices(data, prof.data),
+        "models": models, "episodes": episodes, "episodes_files": files, "joint_units": list(normaliser.joints),
         "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
         "fixed_texts": {tokens_to_text(row): r for r, row in enumerate(rows)}, "free_text": free_text,
         "arm": _arm(), "cube_rgba": {c: list(v) for c, v in CUBE_RGBA.items()},
         "sim_runs": "sim_runs.json" if simulate else None, "frames": frames,
+        "sim_run_episodes": [str(test.ids[i]) for i in chosen_episodes(test)] if simulate else [],
     }
     if simulate:
         simulator_runs(out, trained, source, {"profile": prof.name, "seed": seed}, progress=progress)
+    if parity:
+        write_parity(out, trained, data, normaliser, episodes)
     atomic_write_text(out / "manifest.json", json.dumps(manifest))
     return manifest
 

@@ -3,11 +3,14 @@
 Paper, Sec. 3: PGAE-BERT reads any text and always acts. :mod:`pgae_lite.freeform.refusals` decides
 first whether the robot acts on a free instruction, from its words, the model's readback and the
 scene, reading the phrase lexicon and WordNet. The page has neither, so the build writes what the
-rule reads, and ``book/_js/pgae.js`` applies the same rule to it::
+rule reads, and ``book/_js/pgae-refusals.js`` applies the same rule to it. What the robot says is
+no part of this data: each sentence is a template of ``refusals.MESSAGES``, which the page reads from
+its manifest (:mod:`pgae_lite.web.messages`) and fills as Python formats it::
 
     refusals.json        shared by the models:
       negators, sequencers, clause_end, step_end   the rule's closed classes of words and its patterns
-      colours, actions_said                        the world's six colours; what the robot can do
+      colours, actions_said                        the world's six colours (the first: a negation's example);
+                                                   what the robot can do (the field ``actions`` of two messages)
       colour_words       WordNet's words with a sense that is a kind of colour (refusals.is_colour_word)
       verbs              WordNet's words with a verb sense, front-coded (:func:`front_coded`)
     models/NAME.refusals.json   one model's reading:

@@ -72,6 +72,15 @@ WORD_WEIGHTS: dict[str, float] = {
 }
 
 
+#: This module's error messages as templates (``str.format``, named fields); the page fills the same ones.
+MESSAGES: dict[str, str] = {
+    "unknown_signal": "unknown signal {signal}; the signals are: {signals}",
+    "unknown_words": "unknown word{s} {words} in {text}; the vocabulary is: {vocabulary}",
+    "description_length": "a description has 3 words (action colour speed), got {count} in {text}",
+    "wrong_slot": "{word} cannot be the {slot} word in {text}; allowed: {allowed}",
+}
+
+
 class LanguageError(PGAELiteError, ValueError):
     """Bad user text or signal; the message says what was wrong and what is allowed."""
 
@@ -166,7 +175,7 @@ def normalise_signal(signal: str) -> str:
     """Return the canonical signal name; accepts ``repeat_action``, ``Repeat Action:``…"""
     key = re.sub(r"[\s_:-]+", " ", str(signal)).strip().lower()
     if key not in SIGNALS:
-        raise LanguageError(f"unknown signal {signal!r}; the signals are: {', '.join(SIGNALS)}")
+        raise LanguageError(MESSAGES["unknown_signal"].format(signal=repr(signal), signals=", ".join(SIGNALS)))
     return key
 
 
@@ -201,8 +210,8 @@ def tokenize(text: str, lexicon: Lexicon | None = None) -> list[str]:
     if unknown:
         vocab = ", ".join(sorted(w for w in lex.vocabulary if w != BOS_EOS))
         listed = ", ".join(repr(w) for w in dict.fromkeys(unknown))
-        raise LanguageError(f"unknown word{'s' if len(set(unknown)) > 1 else ''} {listed} in {text!r}; "
-                            f"the vocabulary is: {vocab}")
+        raise LanguageError(MESSAGES["unknown_words"].format(s="s" if len(set(unknown)) > 1 else "", words=listed,
+                                                             text=repr(text), vocabulary=vocab))
     return tokens
 
 
@@ -216,14 +225,14 @@ def parse_description(text: str, lexicon: Lexicon | None = None
     lex = lexicon or DEFAULT_LEXICON
     tokens = tokenize(text, lex)
     if len(tokens) != 3:
-        raise LanguageError(
-            f"a description has 3 words (action colour speed), got {len(tokens)} in {text!r}")
+        raise LanguageError(MESSAGES["description_length"].format(count=str(len(tokens)), text=repr(text)))
     canon = []
     for token, slot, name in zip(tokens, lex.slots, SLOT_NAMES):
         word = lex.canonical.get(token)
         if word not in slot:
             allowed = ", ".join(w2 for w in slot for w2 in (w, lex.synonym[w]))
-            raise LanguageError(f"{token!r} cannot be the {name} word in {text!r}; allowed: {allowed}")
+            raise LanguageError(MESSAGES["wrong_slot"].format(word=repr(token), slot=name, text=repr(text),
+                                                              allowed=allowed))
         canon.append(word)
     return tuple(canon)  # type: ignore[return-value]
 
