@@ -47,7 +47,8 @@
     if (type === "float") return Number.isNaN(v) ? "nan" : !Number.isFinite(v) ? (v > 0 ? "inf" : "-inf") : String(v);
     if (type === "str") return pyrepr(v);
     if (type === "list") return `[${v.map(pyvalue).join(", ")}]`;
-    return type === "int" ? String(v) : `{${Object.entries(v).map(([k, x]) => `${pyrepr(k)}: ${pyvalue(x)}`).join(", ")}}`;
+    if (type === "int") return String(v);
+    return `{${Object.entries(v).map(([k, x]) => `${pyrepr(k)}: ${pyvalue(x)}`).join(", ")}}`;
   }
 
   function make(m) {
@@ -66,8 +67,9 @@
     // pgae_lite.util.checks.whole_number
     function wholeNumber(name, value, low, high = null) {
       const allowed = high === null ? say("whole_number_at_least", {low}) : say("whole_number_between", {low, high});
-      if (pytype(value) !== "int") fail("whole_number_type", {name, allowed, value: pyvalue(value), type: pytype(value)});
-      if (value < low || (high !== null && value > high)) fail("whole_number_range", {name, allowed, value: pyvalue(value)});
+      const shown = pyvalue(value);
+      if (pytype(value) !== "int") fail("whole_number_type", {name, allowed, value: shown, type: pytype(value)});
+      if (value < low || (high !== null && value > high)) fail("whole_number_range", {name, allowed, value: shown});
       return value;
     }
 
@@ -87,8 +89,8 @@
       }
       if (unknown.length) {
         const listed = [...new Set(unknown)];
-        fail("unknown_words", {s: listed.length > 1 ? "s" : "", words: listed.map(pyrepr).join(", "), text: pyrepr(text),
-                               vocabulary: vocab.filter(w => w !== vocab[0]).sort().join(", ")});
+        fail("unknown_words", {s: listed.length > 1 ? "s" : "", words: listed.map(pyrepr).join(", "),
+                               text: pyrepr(text), vocabulary: vocab.filter(w => w !== vocab[0]).sort().join(", ")});
       }
       return tokens;
     }
@@ -112,7 +114,9 @@
         return {words: tokenize(text), meaning, free: false};
       } catch (e) {
         if (model.reads !== "features") fail("lstm_reads_vocabulary", {error: e.message});
-        if (!m.reads_words[m.signals.indexOf(signal)]) fail("signal_reads_no_words", {signal: pyrepr(signal), error: e.message});
+        if (!m.reads_words[m.signals.indexOf(signal)]) {
+          fail("signal_reads_no_words", {signal: pyrepr(signal), error: e.message});
+        }
         return {words: null, meaning: null, free: true};
       }
     }
@@ -138,7 +142,8 @@
       const [action, colour, speed] = meaning, [left, right] = P.scenes[arrangement];
       if (colour !== left && colour !== right) fail("no_cube_in_arrangement", {colour, arrangement, left, right});
       const k = P.action_sides.findIndex(([a, s]) => a === action && s === (colour === left ? "L" : "R"));
-      return P.scenes.length * P.action_sides.length * P.speeds.indexOf(speed) + P.action_sides.length * arrangement + k;
+      const sides = P.action_sides.length;
+      return P.scenes.length * sides * P.speeds.indexOf(speed) + sides * arrangement + k;
     }
     // playground.find_episode: the variation-th recording of a pattern among the page's episodes.
     function findEpisode(pattern, variation) {
@@ -168,13 +173,16 @@
       const held = s === m.describe ? n - 1 : s === m.repeat_language ? 0 : -1;   // one pose held, or none
       const dec = new Float32Array(V * (n - 1));
       for (let t = 0; t < n - 1; t++) dec.set(step(held >= 0 ? held : t).subarray(0, V), V * t);
-      return {tokens, action: values.slice(at, at + W * shown), shown, dec, start: step(held >= 0 ? held : 0).slice(V, W), n};
+      return {tokens, action: values.slice(at, at + W * shown), shown, dec,
+              start: step(held >= 0 ? held : 0).slice(V, W), n};
     }
 
     // The recorded joints of an episode (steps, 5) in the data's units, from its file's values.
     function recorded(ep, values) {
       const out = [];
-      for (let t = 0; t < ep.steps; t++) out.push(Array.from(values.subarray(ep.offset + W * t + V, ep.offset + W * (t + 1)), toData));
+      for (let t = 0; t < ep.steps; t++) {
+        out.push(Array.from(values.subarray(ep.offset + W * t + V, ep.offset + W * (t + 1)), toData));
+      }
       return out;
     }
 
@@ -229,10 +237,11 @@
       if (s === m.repeat_language) return recorded.map(() => recorded[0]);
       return recorded;
     }
-    const toData = (v) => { const [lo, hi] = m.joint_units; return (v + 1) * (hi - lo) / 2 + lo; };   // [-1, 1] -> units
+    const [lo, hi] = m.joint_units, toData = (v) => (v + 1) * (hi - lo) / 2 + lo;   // [-1, 1] -> the data's units
 
     return {say, wholeNumber, normaliseSignal, tokenize, parseDescription, readTyped, inputText, scenePattern,
-            patternOf, patternFor, findEpisode, inputs, recorded, decode, choices, isCorrect, actedOn, nrmse, target, toData,
+            patternOf, patternFor, findEpisode, inputs, recorded, decode, choices, isCorrect, actedOn, nrmse, target,
+            toData,
             pyrepr, pyvalue, strip};
   }
 

@@ -137,13 +137,15 @@
   // The words of a text the lookup replaces, [word, replacement] in the text's order (lookup.replacements).
   async function replacements(name, text) {
     const words = await wordTable(name);
-    return [...new Set(text.match(WORD) || [])].filter(w => words[w.toLowerCase()]).map(w => [w, words[w.toLowerCase()]]);
+    return [...new Set(text.match(WORD) || [])].filter(w => words[w.toLowerCase()])
+      .map(w => [w, words[w.toLowerCase()]]);
   }
 
   // encoder.encode_texts([told]) (1, D): the text read through the lookup; a text the tuned variant was
   // trained on comes from its table, any other runs the tokenizer, the transformer and the model's head.
   async function encodeText(name, told) {
-    const m = manifest.models[name], [{tokenizer, transformer}, graph] = await Promise.all([loadFreeText(), head(name)]);
+    const m = manifest.models[name];
+    const [{tokenizer, transformer}, graph] = await Promise.all([loadFreeText(), head(name)]);
     const read = await readAs(name, told);
     if (m.fixed_from_table && read in manifest.fixed_texts) {
       await session(name);                                          // (which starts loading the table)
@@ -208,7 +210,8 @@
     await load();
     const {model} = args, m = manifest.models[model];
     if (!m || !Object.hasOwn(manifest.models, model)) {
-      throw new Error(L.say("unknown_model", {model: L.pyvalue(model), models: Object.keys(manifest.models).join(", ")}));
+      const models = Object.keys(manifest.models).join(", ");
+      throw new Error(L.say("unknown_model", {model: L.pyvalue(model), models}));
     }
     // In play's order: the scene, the signal, the route, the text, the pattern, the episode.
     const [arrangement, action, variation] = place(args);
@@ -274,7 +277,8 @@
     "{episode}", String(episode).replace(/^sim\//, "")).replace("{which}", which)) : null);
   const fk = (q) => window.pgaeArm.fk(manifest.arm, q);
 
-  window.pgae = {run, load, simulated, readAs, replacements, refusal, frame, fk, manifest: () => manifest, logic: () => L};
+  window.pgae = {run, load, simulated, readAs, replacements, refusal, frame, fk,
+                 manifest: () => manifest, logic: () => L};
   document.addEventListener("DOMContentLoaded", () => {
     document.querySelectorAll(".pgae-live").forEach(el => window.pgaeWidget && window.pgaeWidget(el));
   });
