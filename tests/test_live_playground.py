@@ -298,3 +298,59 @@ def test_the_page_refuses_what_python_refuses(page, name):
         assert r == (f"refused: {why}" if why else disagreement(w["understood"], ep["pattern"])), text
     assert refused >= len(INSTRUCTIONS) // 2                  # the rule ran: most of these are refused
     assert not errors, errors
+
+
+def _in_widget(pg, choices: dict[str, str]) -> dict | str:
+    """Set the widget's controls by their names (a select's value, or the text) and press Run: the result it
+    stored, or the message it shows instead."""
+    widget = pg.locator(".pgae-live").first
+    widget.evaluate("w => { delete w.dataset.result; }")
+    for name, value in choices.items():
+        control = widget.locator(f"[aria-label='{name}']").first
+        if name == "text":
+            control.fill(value)
+        else:
+            control.select_option(value)
+            control.dispatch_event("change")
+    widget.locator("button.pgae-live-run").click()
+    pg.wait_for_function("""() => { const w = document.querySelector('.pgae-live');
+        return w.dataset.result !== undefined || !w.querySelector('.pgae-live-error').hidden; }""", timeout=120_000)
+    stored = widget.get_attribute("data-result")
+    return json.loads(stored) if stored else widget.locator(".pgae-live-error").inner_text()
+
+
+@pytest.mark.parametrize("width", [1280, 390])
+def test_the_widget_refuses_says_back_picks_and_says_how_sure_on_a_phone_too(page, width):
+    """The four things a reader does with the live box, at a desktop's and a phone's width: a refused
+    instruction (the drawing hidden, the page's sentence shown), a said-back execution, a typed description
+    that picks its episode, and nonsense with how sure the decoder was; screenshots of each."""
+    pg, errors = page
+    pg.set_viewport_size({"width": width, "height": 900})
+    widget, shots = pg.locator(".pgae-live").first, ROOT / "_build" / "screenshots"
+    shots.mkdir(parents=True, exist_ok=True)
+    free = [name for name in FREE_MODELS if MANIFEST["models"][name]["route"] == "said back"]
+    first = MANIFEST["episodes"][0]
+    left, right = first["scene"]
+    place = {"cubes": str(first["arrangement"]), "action": str(first["action"]), "variation": "0"}
+    cases = {"refused": {"model": free[0], "signal": "execute", **place, "text": f"don't push the {left} cube"},
+             "said-back": {"model": free[0], "signal": "execute", **place, "act on": "said back",
+                           "text": f"please push the {left} cube slowly"},
+             "description": {"model": "PGAE", "signal": "execute", **place, "text": f"pull {right} fast"},
+             "nonsense": {"model": FREE_MODELS[0], "signal": "repeat language", **place, "text": "blorp fizz wug"}}
+    got, shown = {}, {}
+    for name, choices in cases.items():
+        got[name] = _in_widget(pg, choices)
+        widget.screenshot(path=str(shots / f"live-{name}-{width}px.png"))
+        assert pg.evaluate("document.documentElement.scrollWidth") <= width + 1, (name, width)
+        assert widget.locator(".pgae-live-result").is_hidden() == isinstance(got[name], str), name   # none stale
+        shown[name] = widget.inner_text()
+    assert got["refused"].startswith("Cannot run this: I can't do") and "what not to do" in got["refused"]
+    assert got["said-back"]["route"] == "said back" and got["said-back"]["acted_on"] is not None
+    assert f"acted on (said back): {got['said-back']['acted_on']!r}" in shown["said-back"]
+    asked = got["description"]
+    assert asked["pattern"] != first["pattern"] and asked["episode"].startswith(f"sim/{asked['pattern']:03d}-")
+    nonsense = got["nonsense"]
+    assert nonsense["understood_choices"] and widget.locator("table.pgae-live-choices").count() >= 1
+    assert f"{nonsense['understood_choices'][0]['p']:.2f}" in shown["nonsense"]       # how sure, as a number
+    pg.set_viewport_size({"width": 1280, "height": 900})
+    assert not errors, errors
