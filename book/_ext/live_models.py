@@ -1,8 +1,8 @@
-"""The live playground's files: the trained models and test episodes, written into the built book.
+"""The live playground's files: the trained models and the episodes, written into the built book.
 
 At the end of an HTML build, ``pgae_lite.web.assets.export_web`` (what ``python -m pgae_lite
 export-web`` runs) writes the playground's models (ONNX), their feature tables, the sentence
-encoder for free text, the test episodes and the simulator's closed-loop runs to ``_static/web/``
+encoder for free text, the episodes and the simulator's closed-loop runs to ``_static/web/``
 from the cache, for the profile the chapters ran with (``PGAE_LITE_PROFILE``, ``book`` when
 unset). The chapters have trained those models by then (executed, or by the notebook run before
 a build with execution off), so nothing is trained here unless the cache lacks a model. ``book/_js/pgae.js`` reads them.
@@ -23,9 +23,10 @@ def export(app, exception):
     manifest = export_web(Path(app.outdir) / "_static" / "web", get_profile())     # the profile, resolved here
     sizes = sum(m["bytes"] for m in manifest["models"].values())
     free = (manifest["free_text"] or {}).get("bytes", 0)
+    test = sum(e["split"] == "test" for e in manifest["episodes"])
     logger.info(f"live playground: {len(manifest['models'])} models ({sizes / 1e6:.1f} MB of graphs, "
-                f"{free / 1e6:.1f} MB more for free text) and {len(manifest['episodes'])} test episodes in "
-                f"_static/web ({manifest['profile']} profile)")
+                f"{free / 1e6:.1f} MB more for free text), {test} test episodes and "
+                f"{len(manifest['episodes']) - test} from training in _static/web ({manifest['profile']} profile)")
 
 
 def setup(app):
