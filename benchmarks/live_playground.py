@@ -20,7 +20,7 @@ Then, for the PGAE-BERT models, free text (the project's paraphrases, freeform/p
 same page: ``free_text_bytes``, every response body from the first free text until its result (the
 tokenizer, the sentence encoder, the model's head and word table); ``seconds_to_first_free_text``;
 ``seconds_per_free_text`` (the median over ``--runs`` further sentences); and ``parity``: every
-paraphrase, and ``--per-kind`` sentences of each kind of benchmarks/refusals.py's grammar, run in the
+paraphrase, and ``--per-kind`` sentences of each kind of the refusal grammar (freeform/refusal_grammar.py), run in the
 page against Python (:func:`pgae_lite.web.sentence.free_text_reference` and the refusal rule): the texts
 whose refusal, words or readback differ, and the largest joint difference relative to the joint range;
 then the same parity with the encoder's weights in float32 (``export-web --float32``).
@@ -144,15 +144,16 @@ def both_models(site: str, browser) -> dict:
 
 def parity(site: str, browser, name: str, manifest: dict, per_kind: int, profile) -> dict:
     """Free text in the page against Python: every paraphrase, each on a test episode with its cube, and
-    ``per_kind`` sentences of each kind of benchmarks/refusals.py's grammar, each on a random test episode.
+    ``per_kind`` sentences of each kind of the refusal grammar (pgae_lite.freeform.refusal_grammar), each on
+    a random test episode.
     Python's refusal refuses a text or not; the page must refuse it with the same sentence, or give the
     same words and readback, and joints within float16 rounding. ``profile``: the Profile the page was exported
     with (its name is the manifest's)."""
     import random
 
     import numpy as np
-    from refusals import CLASSES, sentence
 
+    from pgae_lite.freeform.refusal_grammar import CLASSES, sentence
     from pgae_lite.freeform.refusals import refusal
     from pgae_lite.runs.data import simulated_dataset
     from pgae_lite.runs.pipeline import trained_model
@@ -206,7 +207,7 @@ def main() -> None:
     bench.parser.add_argument("--book", default=str(ROOT / "_build" / "html"), help="the built book")
     bench.parser.add_argument("--runs", type=int, default=20, help="runs timed after the first, per model")
     bench.parser.add_argument("--per-kind", type=int, default=20,
-                              help="sentences of each kind of benchmarks/refusals.py's grammar in the free-text parity")
+                              help="sentences of each kind of the refusal grammar in the free-text parity")
     args = bench.parse()
     from playwright.sync_api import sync_playwright
 

@@ -10,4 +10,5 @@ Not in the paper, which says PGAE-BERT "has the potential to recognise unseen na
 - ``paraphrases``        held-out free-form paraphrases of the test instructions
 - ``refusals``           what the robot will not do with a free instruction, and says instead
 - ``refusal_cases``      the refusal rule's test cases: for the unit tests, and the page's parity check
+- ``refusal_grammar``    a grammar of instructions to refuse and to act on: the refusal benchmark's, and the page's
 """

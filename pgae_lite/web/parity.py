@@ -12,7 +12,8 @@ with no book build. Every entry is an input and Python's answer (its value, or i
     batches    (episode, signal, words) -> the graph's inputs (episode_inputs of make_batch)
     readings   (model, text) -> the text as the model reads it, and the words its lookup replaced
     refusals   (model, text, scene, readback) -> the refusal's sentence, or None; every case of
-               pgae_lite.freeform.refusal_cases, and the paraphrases
+               pgae_lite.freeform.refusal_cases, the paraphrases, and 40 sentences of each class of
+               pgae_lite.freeform.refusal_grammar
     choices    logits -> word_choices (how sure of each word)
     plays      (model, the page's run arguments) -> play's result (loop=None), or its error
 
@@ -22,6 +23,7 @@ held-out evaluation sentence.
 from __future__ import annotations
 
 import json
+import random
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +31,7 @@ import torch
 
 from pgae_lite.freeform.paraphrases import load_paraphrases
 from pgae_lite.freeform.refusal_cases import refusal_cases
+from pgae_lite.freeform.refusal_grammar import CLASSES, sentence
 from pgae_lite.freeform.refusals import refusal
 from pgae_lite.model.signals import make_batch, signal_ids
 from pgae_lite.robot.instructions import default_route
@@ -108,8 +111,16 @@ def _readings(encoders: dict, texts: list[str]) -> list[dict]:
     return out
 
 
+def _grammar(per_class: int = 40, seed: int = 0) -> list[dict]:
+    """``per_class`` sentences of each class of the refusal grammar, each told in a random arrangement."""
+    rng = random.Random(seed)
+    return [{"text": sentence(kind, scene, rng), "scene": list(scene), "understood": None}
+            for kind in CLASSES for scene in (rng.choice(ARRANGEMENTS) for _ in range(per_class))]
+
+
 def _refusals(encoders: dict) -> list[dict]:
     cases = refusal_cases() + [{"text": p.text, "scene": None, "understood": None} for p in load_paraphrases()]
+    cases += _grammar()
     return [{"model": name, "text": c["text"], "scene": c["scene"], "understood": c["understood"],
              "message": refusal(c["text"], encoder, tuple(c["scene"]) if c["scene"] else None, c["understood"])}
             for name, encoder in encoders.items() for c in cases]
