@@ -1,4 +1,4 @@
-"""Command line: ``python -m pgae_lite reproduce``, ``simulate`` and ``export-web``.
+"""Command line: ``python -m pgae_lite reproduce``, ``simulate``, ``export-web`` and ``student-edition``.
 
 ``reproduce`` trains the chosen rows of the paper's Table 1 (PGAE, PGAE-BERT,
 PGAE-self, PGAE-opposite; resuming interrupted runs) in the chosen profile, on
@@ -6,7 +6,9 @@ the authors' data or on our simulated data, evaluates them on the test split,
 prints the table next to the paper's rows and writes ``results.json`` and
 ``predictions.npz`` to the output folder. ``simulate`` records the dataset. ``export-web`` writes
 the live playground's files (the trained models as ONNX, the test episodes, the simulator's runs)
-into a folder, from the cache; the book's build runs it into ``_static/web``.
+into a folder, from the cache; the book's build runs it into ``_static/web``. ``student-edition`` writes the
+book's sources and notebooks without the exercises' solutions into a new folder, and with ``--build`` builds
+that book.
 
 Every argument is checked before any data is read. A bad one, or any error of
 the package (:class:`~pgae_lite.util.errors.PGAELiteError`), prints one line
@@ -105,6 +107,15 @@ def main(argv: list[str] | None = None) -> int:
                      help="the sentence encoder's weights in float32: the page then reads free text exactly as "
                           "Python does, to float32 rounding, but fetches about twice the bytes (float16 by default)")
     web.add_argument("--no-progress", action="store_true", help="no progress bar")
+    stu = sub.add_parser("student-edition", help="write (and build) the book without the exercises' solutions",
+                         description="Write the book's sources into OUT with every exercise's solution removed: "
+                                     "the notebooks without solutions or outputs, and a _config.yml that hides "
+                                     "solutions. The instructor edition is the repository itself. OUT must be "
+                                     "outside the repository, and new, empty or written by this command before.")
+    stu.add_argument("out", metavar="OUT", help="the folder to write (created if missing)")
+    stu.add_argument("--build", action="store_true",
+                     help="also build it with execution off: the book in OUT/_build/html, the notebooks in "
+                          "OUT/notebooks")
     args = parser.parse_args(argv)
     from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
@@ -124,6 +135,17 @@ def run_command(args: argparse.Namespace) -> int:
     from pgae_lite.util.checks import whole_number
     from pgae_lite.util.errors import ArgumentError
 
+    if args.command == "student-edition":    # no profile: nothing is trained or read from the cache
+        from pgae_lite.course.student_edition import build_student_edition, write_student_edition
+
+        out = write_student_edition(args.out)
+        print(f"student edition: the book's sources without solutions in {out} (notebooks in {out / 'notebooks'})")
+        if not args.build:
+            return 0
+        rc = build_student_edition(out)
+        if rc == 0:
+            print(f"student edition built: {out / '_build' / 'html' / 'index.html'}")
+        return rc
     try:                      # --profile is checked by argparse; this checks the environment variable too
         profile = get_profile(args.profile)
     except ValueError as e:

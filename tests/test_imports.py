@@ -100,7 +100,8 @@ def unit(name: str) -> str:
 #: The model imports only the world, the dataset type and the utilities (never the simulator, which records
 #: our dataset above it); the pretrained encoders (bert) build on the model, free-form language on them;
 #: the one training loop on the model alone (its caller hands it the rest); config composes each part's
-#: settings; runs, robot and web are on top.
+#: settings; runs, robot and web are on top, and course (handing the book out) above everything, imported by
+#: the command line alone.
 LAYERS = {
     "util": set(),
     "world": {"util"},
@@ -120,7 +121,9 @@ LAYERS = {
               "util"},
     "web": {"robot", "runs", "config", "freeform", "train", "evaluate", "bert", "model", "cae", "data", "sim",
             "world", "util"},
-    "__main__": {"web", "runs", "config", "sim", "data", "util"},
+    "course": {"web", "robot", "runs", "config", "freeform", "train", "evaluate", "bert", "model", "cae", "data",
+               "sim", "viz", "exercises", "world", "util"},
+    "__main__": {"course", "web", "runs", "config", "sim", "data", "util"},
     "pgae_lite": set(),
 }
 

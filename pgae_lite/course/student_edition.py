@@ -1,0 +1,160 @@
+"""The student edition: the book and its notebooks without the exercises' solutions (not in the paper).
+
+The instructor edition is the repository itself. :func:`write_student_edition` writes a copy of the
+book's sources into a new folder, from the same files (no chapter is kept twice): ``_config.yml`` with
+sphinx-exercise's ``hide_solutions: true`` under ``sphinx.config``, ``_toc.yml``, the ``book/`` folder
+(pages, local extensions, scripts, ``references.bib``) and every notebook as :func:`student_notebook`
+makes it. ``python -m pgae_lite student-edition OUT --build`` also builds it (``OUT/_build/html``).
+
+Solutions are known in two forms: a ``{solution}`` directive in a markdown cell, as a MyST colon fence
+(``:::{solution} label`` ... ``:::``, as the book writes them) or a backtick fence; and a whole cell tagged
+``solution`` (a convention the book does not use today, removed if it ever does).
+"""
+from __future__ import annotations
+
+import copy
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import yaml
+
+from pgae_lite.util.errors import PGAELiteError
+
+ROOT = Path(__file__).resolve().parents[2]
+MARKER = ".student-edition"             # written first into OUT: a folder with it is one this module made
+SOLUTION_TAG = "solution"
+_FENCE = re.compile(r"^ {0,3}(:{3,}|`{3,}|~{3,})\s*(.*?)\s*$")
+
+
+def strip_solutions(markdown: str) -> str:
+    """``markdown`` without its ``{solution}`` directives, each removed whole with its fence.
+
+    A directive ends where MyST ends it: at the first line of only the fence's character, at least as
+    many as opened it (so code fences and shorter nested colon fences inside it stay inside it). A
+    ``{solution}`` shown inside a code block is text, not a directive, and stays.
+    """
+    lines = markdown.splitlines(keepends=True)
+    out: list[str] = []
+    i = 0
+    while i < len(lines):
+        match = _FENCE.match(lines[i])
+        if not match:
+            out.append(lines[i])
+            i += 1
+            continue
+        marker, info = match.groups()
+        end = _closing(lines, i + 1, marker)
+        if info.startswith("{solution}"):
+            i = end + 1
+            if i < len(lines) and not lines[i].strip() and (not out or not out[-1].strip()):
+                i += 1                  # one blank line of the two around the block goes with it
+            continue
+        if marker[0] == ":":            # another directive: its content may hold solutions too
+            out.append(lines[i])
+            out.append(strip_solutions("".join(lines[i + 1:end])))
+            out.extend(lines[end:end + 1])
+        else:                           # a code block: its text stays as written
+            out.extend(lines[i:end + 1])
+        i = end + 1
+    return "".join(out)
+
+
+def _closing(lines: list[str], start: int, marker: str) -> int:
+    """The index of the line that closes a fence opened with ``marker`` (len(lines) if none does)."""
+    for j in range(start, len(lines)):
+        match = _FENCE.match(lines[j])
+        if match and not match.group(2) and match.group(1)[0] == marker[0] and len(match.group(1)) >= len(marker):
+            return j
+    return len(lines)
+
+
+def student_notebook(nb: dict) -> dict:
+    """A copy of notebook ``nb`` (nbformat 4 JSON) for students: solutions out of its markdown cells, cells
+    tagged ``solution`` and markdown cells left empty removed, every output and execution count cleared."""
+    nb = copy.deepcopy(nb)
+    cells = []
+    for cell in nb.get("cells", []):
+        if SOLUTION_TAG in cell.get("metadata", {}).get("tags", []):
+            continue
+        if cell.get("cell_type") == "markdown":
+            source = cell.get("source", "")
+            text = strip_solutions(source if isinstance(source, str) else "".join(source))
+            if not text.strip():
+                continue
+            cell["source"] = text.splitlines(keepends=True)
+        elif cell.get("cell_type") == "code":
+            cell["outputs"], cell["execution_count"] = [], None
+        cells.append(cell)
+    nb["cells"] = cells
+    return nb
+
+
+def student_config(text: str) -> str:
+    """The book's ``_config.yml`` (as text) with ``hide_solutions: true`` under ``sphinx.config``: one
+    line inserted, comments kept; written anew from its data only where a line cannot do it."""
+    config = yaml.safe_load(text) or {}
+    wanted = copy.deepcopy(config)
+    sphinx = wanted["sphinx"] = wanted.get("sphinx") or {}
+    sphinx["config"] = {**(sphinx.get("config") or {}), "hide_solutions": True}
+    inserted = re.sub(r"(?m)^(sphinx:[^\n]*\n(?:(?:  [^\n]*|[ \t]*)\n)*?  config:[ \t]*\n)",
+                      r"\1    hide_solutions: true   # the student edition: no solutions\n", text, count=1)
+    if yaml.safe_load(inserted) == wanted:
+        return inserted
+    return yaml.safe_dump(wanted, sort_keys=False, allow_unicode=True)
+
+
+def _check_out(out: Path, root: Path) -> None:
+    if out == root or root in out.parents:
+        raise PGAELiteError(f"the student edition goes outside the repository, not into {out}: "
+                            "choose a folder elsewhere, e.g. /tmp/student")
+    if out.exists() and not out.is_dir():
+        raise PGAELiteError(f"{out} is a file, not a folder: choose a new folder for the student edition")
+    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).is_file():
+        raise PGAELiteError(f"{out} is a non-empty folder that this command did not make: choose a new or "
+                            "empty folder, so that none of your files is overwritten")
+
+
+def write_student_edition(out: Path, root: Path = ROOT) -> Path:
+    """Write the student edition's sources into ``out`` and return it (resolved): a new or empty folder
+    outside the repository ``root``, or one this function wrote before (its ``book/``, ``notebooks/``,
+    ``_config.yml`` and ``_toc.yml`` are then written again; its ``_build`` is kept)."""
+    out, root = Path(out).expanduser().resolve(), Path(root).resolve()
+    _check_out(out, root)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / MARKER).write_text("Written by `python -m pgae_lite student-edition`: the student edition of "
+                              f"the book in {root}. Writing it again replaces these files.\n", encoding="utf-8")
+    for folder in ("book", "notebooks"):
+        shutil.rmtree(out / folder, ignore_errors=True)
+    shutil.copytree(root / "book", out / "book", ignore=shutil.ignore_patterns("__pycache__", ".ipynb_checkpoints"))
+    (out / "notebooks").mkdir()
+    for path in sorted((root / "notebooks").glob("*.ipynb")):
+        nb = student_notebook(json.loads(path.read_text(encoding="utf-8")))
+        (out / "notebooks" / path.name).write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n",
+                                                   encoding="utf-8")
+    shutil.copyfile(root / "_toc.yml", out / "_toc.yml")
+    (out / "_config.yml").write_text(student_config((root / "_config.yml").read_text(encoding="utf-8")),
+                                     encoding="utf-8")
+    return out
+
+
+def build_student_edition(out: Path) -> int:
+    """Build the written edition in ``out`` into ``out/_build/html`` with execution off (as the tests build
+    the book: a copy of its config, local extension folders made absolute); the build's exit status."""
+    out = Path(out).resolve()
+    config = yaml.safe_load((out / "_config.yml").read_text(encoding="utf-8"))
+    config.setdefault("execute", {})["execute_notebooks"] = "off"
+    extensions = config.get("sphinx", {}).get("local_extensions") or {}
+    for name, path in extensions.items():
+        extensions[name] = str(out / path)
+    jupyter_book = Path(sys.executable).with_name("jupyter-book")
+    command = str(jupyter_book) if jupyter_book.exists() else "jupyter-book"
+    with tempfile.TemporaryDirectory(prefix="pgae-student-config.") as folder:
+        path = Path(folder) / "_config.yml"
+        path.write_text(yaml.safe_dump(config, sort_keys=False, allow_unicode=True), encoding="utf-8")
+        return subprocess.run([command, "build", str(out), "--config", str(path)], env=os.environ).returncode
