@@ -58,7 +58,11 @@
                                    placeholder: "or type a description, e.g. push red slowly; PGAE-BERT: any sentence"});
     const button = element("button", {type: "button", class: "pgae-live-run", text: "Run"});
     const routeField = field("act on", route), busy = element("span", {class: "pgae-live-busy", role: "status"});
-    const form = element("div", {class: "pgae-live-form"}, field("model", model), field("signal", signal),
+    // The robot, as play's loop: the page runs no physics, so only the simulator's build-time run, or none.
+    const robot = element("select", {class: "pgae-live-robot"});
+    fill(robot, [["built", "closed loop, as run at build time"], ["none", "no robot"]]);
+    const form = element("div", {class: "pgae-live-form"}, field("model", model), field("robot", robot),
+                         field("signal", signal),
                          field("cubes", cubes), field("action", action), field("variation", variation),
                          element("label", {class: "pgae-live-field pgae-live-wide"},
                                  element("span", {class: "pgae-live-name", text: "text"}), text),
@@ -265,7 +269,7 @@
         const r = await window.pgae.run(args), ms = performance.now() - t0;
         const ep = manifest.episodes.find(e => e.id === r.episode);
         // The cubes move only along the simulator's own build-time run of exactly this model, episode and instruction.
-        const sim = r.simulated ? await window.pgae.simulated(r.model, r.episode) : null;
+        const sim = r.simulated && robot.value === "built" ? await window.pgae.simulated(r.model, r.episode) : null;
         error.hidden = true; error.textContent = "";
         showResult(r, ep, ms);
         showCamera(ep);
@@ -279,6 +283,9 @@
                            element("strong", {class: sim.passed ? "pgae-live-right" : "pgae-live-wrong",
                                               text: sim.passed ? "passed" : "failed"}),
                            ". The cubes move as they moved in that run.");
+        } else if (robot.value === "none") {
+          cubesNote.textContent = "No robot: the page shows what the model computed, its joints and NICO's arm drawn " +
+            "from them by forward kinematics; the cubes stay where the recording had them.";
         } else {
           cubesNote.textContent = "The simulator ran only when the book was built, and only for each test episode's " +
             "own instruction; for this instruction the page shows what the model computed: its joints, and NICO's " +
