@@ -113,9 +113,12 @@ def main(argv: list[str] | None = None) -> int:
                                      "solutions. The instructor edition is the repository itself. OUT must be "
                                      "outside the repository, and new, empty or written by this command before.")
     stu.add_argument("out", metavar="OUT", help="the folder to write (created if missing)")
+    stu.add_argument("--executed", metavar="DIR",
+                     help="a folder of the chapters executed (each under its own name), whose outputs the student "
+                          "book shows; without it its pages show no outputs")
     stu.add_argument("--build", action="store_true",
-                     help="also build it with execution off: the book in OUT/_build/html, the notebooks in "
-                          "OUT/notebooks")
+                     help="also build it with execution off: the book in OUT/_build/html (the notebooks to hand "
+                          "out are in OUT/handout)")
     args = parser.parse_args(argv)
     from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
@@ -138,8 +141,9 @@ def run_command(args: argparse.Namespace) -> int:
     if args.command == "student-edition":    # no profile: nothing is trained or read from the cache
         from pgae_lite.course.student_edition import build_student_edition, write_student_edition
 
-        out = write_student_edition(args.out)
-        print(f"student edition: the book's sources without solutions in {out} (notebooks in {out / 'notebooks'})")
+        out = write_student_edition(args.out, executed=args.executed)
+        print(f"student edition: the book's sources without solutions in {out} (the notebooks to hand out in "
+              f"{out / 'handout'})")
         if not args.build:
             return 0
         rc = build_student_edition(out)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 
 import pytest
 import yaml
@@ -134,3 +135,35 @@ def test_the_command_line_refuses_in_one_line(tmp_path):
     r = run("student-edition", ROOT / "student")
     assert r.returncode == 2 and r.stderr.startswith("error: ") and len(r.stderr.strip().splitlines()) == 1
     assert not (ROOT / "student").exists()
+
+
+def test_the_student_book_shows_an_executed_copys_outputs_and_the_handout_none(tmp_path):
+    executed = tmp_path / "executed"
+    executed.mkdir()
+    for path in NOTEBOOKS:                                  # an executed copy: the same code, with an output
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        code = next(c for c in nb["cells"] if c["cell_type"] == "code")
+        code["outputs"] = [{"output_type": "stream", "name": "stdout", "text": ["computed\n"]}]
+        (executed / path.name).write_text(json.dumps(nb), encoding="utf-8")
+    out = write_student_edition(tmp_path / "student", executed=executed)
+    for path in NOTEBOOKS:
+        book = json.loads((out / "notebooks" / path.name).read_text(encoding="utf-8"))
+        handout = json.loads((out / "handout" / path.name).read_text(encoding="utf-8"))
+        assert any(c.get("outputs") for c in book["cells"]), path.name
+        assert not any(c.get("outputs") for c in handout["cells"] if c["cell_type"] == "code"), path.name
+        assert ":::{solution}" not in json.dumps(book) + json.dumps(handout), path.name
+
+
+def test_an_executed_copy_of_other_code_or_a_missing_chapter_is_refused(tmp_path):
+    executed = tmp_path / "executed"
+    executed.mkdir()
+    for path in NOTEBOOKS[1:]:
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        next(c for c in nb["cells"] if c["cell_type"] == "code")["source"] = ["print('older')"]
+        (executed / path.name).write_text(json.dumps(nb), encoding="utf-8")
+    with pytest.raises(PGAELiteError, match=f"holds no executed {NOTEBOOKS[0].name}"):
+        write_student_edition(tmp_path / "a", executed=executed)
+    shutil.copy(NOTEBOOKS[0], executed / NOTEBOOKS[0].name)
+    with pytest.raises(PGAELiteError, match="code differs from the chapter's"):
+        write_student_edition(tmp_path / "b", executed=executed)
+    assert not (tmp_path / "b").exists()                    # refused before anything is written

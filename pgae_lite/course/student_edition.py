@@ -4,7 +4,9 @@ The instructor edition is the repository itself. :func:`write_student_edition` w
 book's sources into a new folder, from the same files (no chapter is kept twice): ``_config.yml`` with
 sphinx-exercise's ``hide_solutions: true`` under ``sphinx.config``, ``_toc.yml``, the ``book/`` folder
 (pages, local extensions, scripts, ``references.bib``) and every notebook as :func:`student_notebook`
-makes it. ``python -m pgae_lite student-edition OUT --build`` also builds it (``OUT/_build/html``).
+makes it: in ``handout/`` without outputs, for students to run; in ``notebooks/``, the book's chapters,
+with the outputs of an executed copy when one is given. ``python -m pgae_lite student-edition OUT
+[--executed DIR] --build`` also builds it (``OUT/_build/html``).
 
 Solutions are known in two forms: a ``{solution}`` directive in a markdown cell, as a MyST colon fence
 (``:::{solution} label`` ... ``:::``, as the book writes them) or a backtick fence; and a whole cell tagged
@@ -74,9 +76,10 @@ def _closing(lines: list[str], start: int, marker: str) -> int:
     return len(lines)
 
 
-def student_notebook(nb: dict) -> dict:
+def student_notebook(nb: dict, keep_outputs: bool = False) -> dict:
     """A copy of notebook ``nb`` (nbformat 4 JSON) for students: solutions out of its markdown cells, cells
-    tagged ``solution`` and markdown cells left empty removed, every output and execution count cleared."""
+    tagged ``solution`` and markdown cells left empty removed, every output and execution count cleared
+    (kept with ``keep_outputs``: the student book then shows what the chapter computed)."""
     nb = copy.deepcopy(nb)
     cells = []
     for cell in nb.get("cells", []):
@@ -88,7 +91,7 @@ def student_notebook(nb: dict) -> dict:
             if not text.strip():
                 continue
             cell["source"] = text.splitlines(keepends=True)
-        elif cell.get("cell_type") == "code":
+        elif cell.get("cell_type") == "code" and not keep_outputs:
             cell["outputs"], cell["execution_count"] = [], None
         cells.append(cell)
     nb["cells"] = cells
@@ -120,23 +123,50 @@ def _check_out(out: Path, root: Path) -> None:
                             "empty folder, so that none of your files is overwritten")
 
 
-def write_student_edition(out: Path, root: Path = ROOT) -> Path:
+def _code(nb: dict) -> list[str]:
+    return ["".join(c.get("source", "")) for c in nb.get("cells", []) if c.get("cell_type") == "code"]
+
+
+def executed_chapter(path: Path, executed: Path) -> dict:
+    """The chapter ``path`` as executed in the folder ``executed`` (same name, outputs in it), after checking
+    that its code is the chapter's: an executed copy of an older chapter is refused in one sentence."""
+    done = executed / path.name
+    if not done.is_file():
+        raise PGAELiteError(f"{executed} holds no executed {path.name}: execute every chapter into it first "
+                            "(see the README: jupyter nbconvert --execute --output-dir ...)")
+    nb = json.loads(done.read_text(encoding="utf-8"))
+    if _code(nb) != _code(json.loads(path.read_text(encoding="utf-8"))):
+        raise PGAELiteError(f"{done}'s code differs from the chapter's ({path}): it was executed from another "
+                            "version; execute the current chapters again")
+    return nb
+
+
+def write_student_edition(out: Path, root: Path = ROOT, executed: Path | None = None) -> Path:
     """Write the student edition's sources into ``out`` and return it (resolved): a new or empty folder
     outside the repository ``root``, or one this function wrote before (its ``book/``, ``notebooks/``,
-    ``_config.yml`` and ``_toc.yml`` are then written again; its ``_build`` is kept)."""
+    ``handout/``, ``_config.yml`` and ``_toc.yml`` are then written again; its ``_build`` is kept).
+
+    ``handout/`` holds the notebooks students get, without solutions or outputs. ``notebooks/`` holds the
+    book's chapters, the same; with ``executed`` (a folder of the chapters executed, each under its own
+    name) they keep its outputs, so the student book shows what each chapter computed."""
     out, root = Path(out).expanduser().resolve(), Path(root).resolve()
     _check_out(out, root)
+    chapters = sorted((root / "notebooks").glob("*.ipynb"))
+    shown = {path.name: executed_chapter(path, Path(executed)) for path in chapters} if executed else {}
     out.mkdir(parents=True, exist_ok=True)
     (out / MARKER).write_text("Written by `python -m pgae_lite student-edition`: the student edition of "
                               f"the book in {root}. Writing it again replaces these files.\n", encoding="utf-8")
-    for folder in ("book", "notebooks"):
+    for folder in ("book", "notebooks", "handout"):
         shutil.rmtree(out / folder, ignore_errors=True)
     shutil.copytree(root / "book", out / "book", ignore=shutil.ignore_patterns("__pycache__", ".ipynb_checkpoints"))
-    (out / "notebooks").mkdir()
-    for path in sorted((root / "notebooks").glob("*.ipynb")):
-        nb = student_notebook(json.loads(path.read_text(encoding="utf-8")))
-        (out / "notebooks" / path.name).write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n",
-                                                   encoding="utf-8")
+    for folder in ("notebooks", "handout"):
+        (out / folder).mkdir()
+    for path in chapters:
+        source = json.loads(path.read_text(encoding="utf-8"))
+        for folder, nb in (("handout", student_notebook(source)),
+                           ("notebooks", student_notebook(shown.get(path.name, source), keep_outputs=True))):
+            (out / folder / path.name).write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n",
+                                                  encoding="utf-8")
     shutil.copyfile(root / "_toc.yml", out / "_toc.yml")
     (out / "_config.yml").write_text(student_config((root / "_config.yml").read_text(encoding="utf-8")),
                                      encoding="utf-8")
