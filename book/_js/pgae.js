@@ -208,8 +208,8 @@
 
   async function run(args = {}) {
     await load();
-    const {model} = args, m = manifest.models[model];
-    if (!m || !Object.hasOwn(manifest.models, model)) {
+    const {model} = args, m = Object.hasOwn(manifest.models, model) ? manifest.models[model] : null;
+    if (!m) {
       const models = Object.keys(manifest.models).join(", ");
       throw new Error(L.say("unknown_model", {model: L.pyvalue(model), models}));
     }
