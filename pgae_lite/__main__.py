@@ -1,4 +1,4 @@
-"""Command line: ``python -m pgae_lite reproduce``, ``simulate``, ``export-web`` and ``student-edition``.
+"""Command line: ``python -m pgae_lite reproduce``, ``simulate``, ``export-web``, ``student-edition`` and ``course``.
 
 ``reproduce`` trains the chosen rows of the paper's Table 1 (PGAE, PGAE-BERT,
 PGAE-self, PGAE-opposite; resuming interrupted runs) in the chosen profile, on
@@ -8,7 +8,8 @@ prints the table next to the paper's rows and writes ``results.json`` and
 the live playground's files (the trained models as ONNX, the test episodes, the simulator's runs)
 into a folder, from the cache; the book's build runs it into ``_static/web``. ``student-edition`` writes the
 book's sources and notebooks without the exercises' solutions into a new folder, and with ``--build`` builds
-that book.
+that book. ``course`` prepares a class's cache, hands out the problem sets and labs, and grades a folder of
+submissions (:mod:`pgae_lite.course.cli`).
 
 Every argument is checked before any data is read. A bad one, or any error of
 the package (:class:`~pgae_lite.util.errors.PGAELiteError`), prints one line
@@ -119,6 +120,9 @@ def main(argv: list[str] | None = None) -> int:
     stu.add_argument("--build", action="store_true",
                      help="also build it with execution off: the book in OUT/_build/html (the notebooks to hand "
                           "out are in OUT/handout)")
+    from pgae_lite.course.cli import add_parser as add_course_parser
+
+    add_course_parser(sub, PROFILE_NAMES)
     args = parser.parse_args(argv)
     from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
@@ -138,6 +142,10 @@ def run_command(args: argparse.Namespace) -> int:
     from pgae_lite.util.checks import whole_number
     from pgae_lite.util.errors import ArgumentError
 
+    if args.command == "course":             # its steps resolve the profile themselves, where one is needed
+        from pgae_lite.course.cli import run as run_course
+
+        return run_course(args)
     if args.command == "student-edition":    # no profile: nothing is trained or read from the cache
         from pgae_lite.course.student_edition import build_student_edition, write_student_edition
 
