@@ -115,7 +115,7 @@ LAYERS = {
     "viz": {"model", "data", "world", "util"},
     "train": {"model", "data", "world", "util"},
     "config": {"train", "model", "cae", "sim", "world", "util"},
-    "exercises": {"train", "evaluate", "model", "data", "sim", "world", "util"},
+    "exercises": {"train", "evaluate", "model", "cae", "data", "sim", "world", "util"},
     "runs": {"config", "freeform", "bert", "train", "evaluate", "model", "cae", "data", "sim", "world", "util"},
     "robot": {"runs", "config", "freeform", "evaluate", "bert", "model", "cae", "data", "sim", "viz", "world",
               "util"},
