@@ -29,6 +29,7 @@ import time
 import zlib
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 import torch
@@ -174,12 +175,15 @@ def as_input(images: np.ndarray | torch.Tensor, device: torch.device | str | Non
 
 
 class ChannelSeparatedCAE(nn.Module):
-    """Three :class:`ChannelAutoencoder` s, one per colour: RGB frames <-> 30 features [R10, G10, B10]."""
+    """Three :class:`ChannelAutoencoder` s, one per colour: RGB frames <-> 30 features [R10, G10, B10].
 
-    def __init__(self, config: CAEConfig = CAEConfig()):
+    ``autoencoder(config)`` builds each colour's (default the book's; the course's lab on the channel widths
+    hands in a student's, a module with ``encode``, ``logits`` and ``forward`` as ChannelAutoencoder's)."""
+
+    def __init__(self, config: CAEConfig = CAEConfig(), autoencoder: Callable[[CAEConfig], nn.Module] | None = None):
         super().__init__()
         self.config = config
-        self.red, self.green, self.blue = (ChannelAutoencoder(config) for _ in COLOURS)
+        self.red, self.green, self.blue = ((autoencoder or ChannelAutoencoder)(config) for _ in COLOURS)
         # Speed: channels-last convolutions train ~15% faster on a CPU (and are harmless on CUDA).
         self.to(memory_format=torch.channels_last)
 
@@ -221,7 +225,8 @@ def _fingerprint(images: np.ndarray) -> dict:
 
 
 def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str | None = None,
-              progress: bool = True, out_path: str | Path | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
+              progress: bool = True, out_path: str | Path | None = None,
+              autoencoder: Callable[[CAEConfig], nn.Module] | None = None) -> tuple[ChannelSeparatedCAE, list[dict]]:
     """Train a :class:`ChannelSeparatedCAE` on ``images`` (N, 120, 160, 3) uint8.
 
     Batches are drawn without replacement from a seeded shuffle (a new one each
@@ -232,8 +237,11 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
 
     With ``out_path`` the finished model is written there atomically; if that
     file already holds a model trained with the same config on the same images
-    it is loaded instead of training again. Any other file there is refused.
+    it is loaded instead of training again. Any other file there is refused. ``autoencoder``: each
+    colour's, as :class:`ChannelSeparatedCAE` takes it (another than the book's is never saved).
     """
+    if autoencoder is not None and out_path is not None:
+        raise ValueError("train_cae saves only the book's ChannelAutoencoder: with autoencoder=, out_path=None")
     if not isinstance(config, CAEConfig):
         raise TypeError(f"train_cae wants a CAEConfig, e.g. pgae_lite.config.get_profile().cae; got {config!r}")
     images = np.asarray(images)
@@ -251,7 +259,7 @@ def train_cae(images: np.ndarray, config: CAEConfig, device: torch.device | str 
         return model, ckpt["history"]
 
     torch.manual_seed(config.seed)
-    model = ChannelSeparatedCAE(config).to(device)
+    model = ChannelSeparatedCAE(config, autoencoder).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=config.lr)
     rng = np.random.default_rng(config.seed)
     t0 = time.perf_counter()

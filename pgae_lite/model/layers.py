@@ -7,9 +7,14 @@ bottleneck "is based on the GMU" (Arevalo et al. 2017).
 Both recurrent classes share one interface, that of ``torch.nn.LSTM`` with
 ``batch_first=True``: ``forward(x, lengths, state) -> (outputs, (h, c))`` with
 ``h, c`` of shape (layers, batch, units), and ``step(x_t, state)`` for one time
-step. A sample's final state is the state after its last valid step.
+step. A sample's final state is the state after its last valid step. Inside
+:func:`recurrent_layers` a layer of one's own with this interface stands in
+for them in every encoder and decoder (not in the paper: the course's GRU lab).
 """
 from __future__ import annotations
+
+import contextlib
+from typing import Callable, Iterator
 
 import torch
 from torch import nn
@@ -159,8 +164,38 @@ class FusedLSTM(nn.Module):
         return inp, (torch.stack(hs), torch.stack(cs))
 
 
+#: the factories of the :func:`recurrent_layers` blocks that are open, the innermost last
+_LAYER_FACTORIES: list[Callable[[int, int, int], nn.Module]] = []
+
+
+@contextlib.contextmanager
+def recurrent_layers(factory: Callable[[int, int, int], nn.Module]) -> Iterator[None]:
+    """Inside the block, every recurrent layer a model builds is ``factory(input_size, hidden_size, num_layers)``
+    in place of its config's cell: a layer of one's own (the course's GRU lab; not in the paper) in every encoder
+    and decoder. The layer needs :class:`PeepholeLSTM`'s interface: ``forward``, ``step`` and ``input_weight``.
+
+        with recurrent_layers(MyGRU):
+            model = PGAE(cfg)
+    """
+    if not callable(factory):
+        raise TypeError(f"recurrent_layers takes a class or function factory(input_size, hidden_size, num_layers); "
+                        f"got {type(factory).__name__}")
+    _LAYER_FACTORIES.append(factory)
+    try:
+        yield
+    finally:
+        _LAYER_FACTORIES.pop()
+
+
 def make_recurrent(cell: str, input_size: int, hidden_size: int, num_layers: int) -> nn.Module:
-    """``cell="peephole"`` (the paper's) or ``"lstm"`` (fused, faster)."""
+    """``cell="peephole"`` (the paper's) or ``"lstm"`` (fused, faster); inside :func:`recurrent_layers`, its
+    factory's layer."""
+    if _LAYER_FACTORIES:
+        layer = _LAYER_FACTORIES[-1](input_size, hidden_size, num_layers)
+        if not isinstance(layer, nn.Module):
+            raise TypeError(f"the recurrent_layers factory returned {type(layer).__name__}; expected an nn.Module "
+                            "with PeepholeLSTM's interface")
+        return layer
     if cell == "peephole":
         return PeepholeLSTM(input_size, hidden_size, num_layers)
     if cell == "lstm":
