@@ -20,8 +20,9 @@ and the book's reference page, ``book/api.md``, to one another):
 - ``viz``        plots and animations for the chapters, by topic
 - ``exercises``  check functions: a student's code against the package's, by chapter
 - ``util``       plumbing: errors, the cache folder, atomic writes, argument checks
-- ``__main__``   the command line: ``python -m pgae_lite --help`` (simulate, reproduce, export-web, student-edition)
-- ``course``     handing the book out as a course: the student edition, without solutions
+- ``__main__``   the command line: ``python -m pgae_lite --help`` (simulate, reproduce, export-web, student-edition,
+                 course)
+- ``course``     handing the book out as a course: the student edition, problem sets and labs, grading
 
 Layers: each folder imports only the folders below it in ``tests/test_imports.py``'s table;
 ``import pgae_lite.model.pgae`` needs no simulator, CAE or transformer.

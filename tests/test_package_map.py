@@ -51,7 +51,21 @@ def top_entries() -> list[str]:
 
 
 def folder_modules(folder: str) -> list[str]:
-    return sorted(p.stem for p in (PACKAGE / folder).glob("*.py") if not p.name.startswith("_"))
+    """The modules of ``pgae_lite/folder`` and its subfolders that are packages (``course/labs``)."""
+    path = PACKAGE / folder
+    return sorted([p.stem for p in path.glob("*.py") if not p.name.startswith("_")]
+                  + [p.name for p in path.iterdir() if (p / "__init__.py").is_file()])
+
+
+def automodules(package: str) -> list[str]:
+    """The ``automodule`` lines of a package's listed modules, a listed subpackage's own modules after it."""
+    lines = []
+    for module, _ in listed(PACKAGE / package / "__init__.py"):
+        dotted = f"pgae_lite.{package}.{module}".replace("/", ".")
+        lines.append(f"\n.. automodule:: {dotted}\n   :members:\n")
+        if (PACKAGE / package / module / "__init__.py").is_file():
+            lines += automodules(f"{package}/{module}")
+    return lines
 
 
 def api_page() -> str:
@@ -64,8 +78,7 @@ def api_page() -> str:
         parts.append(f"\n## `{name}`: {what}\n\n```{{eval-rst}}\n")
         if (PACKAGE / name).is_dir():
             parts.append(f".. automodule:: pgae_lite.{name}\n")
-            for module, _ in listed(PACKAGE / name / "__init__.py"):
-                parts.append(f"\n.. automodule:: pgae_lite.{name}.{module}\n   :members:\n")
+            parts += automodules(name)
         else:
             parts.append(f".. automodule:: pgae_lite.{name}\n   :members:\n")
         parts.append("```\n")
@@ -79,7 +92,9 @@ def test_the_package_lists_every_top_level_entry_once():
 
 
 def test_every_folder_lists_its_modules():
-    for folder in (n for n in top_entries() if (PACKAGE / n).is_dir()):
+    folders = [n for n in top_entries() if (PACKAGE / n).is_dir()]
+    folders += [f"{n}/{p.name}" for n in folders for p in (PACKAGE / n).iterdir() if (p / "__init__.py").is_file()]
+    for folder in folders:
         names = [name for name, _ in listed(PACKAGE / folder / "__init__.py")]
         assert sorted(names) == folder_modules(folder), f"pgae_lite/{folder}/__init__.py's list is not its modules"
 
