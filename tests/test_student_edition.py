@@ -11,7 +11,14 @@ import shutil
 import pytest
 import yaml
 
-from pgae_lite.course.student_edition import MARKER, ROOT, strip_solutions, student_notebook, write_student_edition
+from pgae_lite.course.student_edition import (
+    MARKER,
+    ROOT,
+    instructor_only,
+    strip_solutions,
+    student_notebook,
+    write_student_edition,
+)
 from pgae_lite.util.errors import PGAELiteError
 
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
@@ -71,7 +78,8 @@ def test_every_notebook_loses_its_solutions_and_keeps_its_exercises(path):
     exercises = re.findall(r"(?m)^:::\{exercise\}.*$", before)
     assert re.findall(r"(?m)^:::\{exercise\}.*$", after) == exercises
     assert [c["source"] for c in student["cells"] if c["cell_type"] == "code"] == \
-           [c["source"] for c in nb["cells"] if c["cell_type"] == "code"]
+           [c["source"] for c in nb["cells"] if c["cell_type"] == "code"
+            and "solution" not in c.get("metadata", {}).get("tags", [])]     # the solutions' figures' code goes
     assert all(c["outputs"] == [] for c in student["cells"] if c["cell_type"] == "code")
     assert student_notebook(student) == student
 
@@ -91,9 +99,16 @@ def test_the_written_folder(tmp_path):
     config = yaml.safe_load((out / "_config.yml").read_text(encoding="utf-8"))
     assert config["sphinx"]["config"].pop("hide_solutions") is True
     assert config == original
-    assert (out / "_toc.yml").read_bytes() == (ROOT / "_toc.yml").read_bytes()
+    teachers = [p for p in NOTEBOOKS if instructor_only(json.loads(p.read_text(encoding="utf-8")))]
+    assert [p.stem for p in teachers] == ["A5_teaching"]        # the teachers' page, with the rubrics
+    toc = yaml.safe_load((out / "_toc.yml").read_text(encoding="utf-8"))
+    pages = [c["file"] for part in toc["parts"] for c in part["chapters"]]
+    book = [c["file"] for part in yaml.safe_load((ROOT / "_toc.yml").read_text(encoding="utf-8"))["parts"]
+            for c in part["chapters"]]
+    assert pages == [p for p in book if p != "notebooks/A5_teaching"]
     assert (out / "book" / "references.bib").is_file() and (out / "book" / "_ext" / "live_models.py").is_file()
-    assert sorted(p.name for p in (out / "notebooks").iterdir()) == [p.name for p in NOTEBOOKS]
+    assert sorted(p.name for p in (out / "notebooks").iterdir()) == [p.name for p in NOTEBOOKS if p not in teachers]
+    assert not (out / "handout" / "A5_teaching.ipynb").exists()
     for path in (out / "notebooks").iterdir():
         assert "{solution}" not in path.read_text(encoding="utf-8")
     (out / "_build").mkdir()

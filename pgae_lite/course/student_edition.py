@@ -8,6 +8,9 @@ makes it: in ``handout/`` without outputs, for students to run; in ``notebooks/`
 with the outputs of an executed copy when one is given. ``python -m pgae_lite student-edition OUT
 [--executed DIR] --build`` also builds it (``OUT/_build/html``).
 
+A page for teachers only (notebook metadata ``"pgae": {"instructor_only": true}``, e.g. the page with the
+problem sets' rubrics) is left out of the student edition, and out of its ``_toc.yml``.
+
 Solutions are known in two forms: a ``{solution}`` directive in a markdown cell, as a MyST colon fence
 (``:::{solution} label`` ... ``:::``, as the book writes them) or a backtick fence; and a whole cell tagged
 ``solution`` (a convention the book does not use today, removed if it ever does).
@@ -98,6 +101,18 @@ def student_notebook(nb: dict, keep_outputs: bool = False) -> dict:
     return nb
 
 
+def instructor_only(nb: dict) -> bool:
+    """Whether notebook ``nb`` is a page for teachers only (left out of the student edition)."""
+    return bool(nb.get("metadata", {}).get("pgae", {}).get("instructor_only"))
+
+
+def student_toc(text: str, left_out: list[str]) -> str:
+    """The book's ``_toc.yml`` (as text) without the entries of the pages ``left_out`` (paths without suffix)."""
+    for page in left_out:
+        text = re.sub(rf"(?m)^[ \t]*- file: {re.escape(page)}[ \t]*\n", "", text)
+    return text
+
+
 def student_config(text: str) -> str:
     """The book's ``_config.yml`` (as text) with ``hide_solutions: true`` under ``sphinx.config``: one
     line inserted, comments kept; written anew from its data only where a line cannot do it."""
@@ -151,7 +166,9 @@ def write_student_edition(out: Path, root: Path = ROOT, executed: Path | None = 
     name) they keep its outputs, so the student book shows what each chapter computed."""
     out, root = Path(out).expanduser().resolve(), Path(root).resolve()
     _check_out(out, root)
-    chapters = sorted((root / "notebooks").glob("*.ipynb"))
+    every = sorted((root / "notebooks").glob("*.ipynb"))
+    teachers = [p for p in every if instructor_only(json.loads(p.read_text(encoding="utf-8")))]
+    chapters = [p for p in every if p not in teachers]
     shown = {path.name: executed_chapter(path, Path(executed)) for path in chapters} if executed else {}
     out.mkdir(parents=True, exist_ok=True)
     (out / MARKER).write_text("Written by `python -m pgae_lite student-edition`: the student edition of "
@@ -167,7 +184,8 @@ def write_student_edition(out: Path, root: Path = ROOT, executed: Path | None = 
                            ("notebooks", student_notebook(shown.get(path.name, source), keep_outputs=True))):
             (out / folder / path.name).write_text(json.dumps(nb, indent=1, ensure_ascii=False) + "\n",
                                                   encoding="utf-8")
-    shutil.copyfile(root / "_toc.yml", out / "_toc.yml")
+    (out / "_toc.yml").write_text(student_toc((root / "_toc.yml").read_text(encoding="utf-8"),
+                                              [f"notebooks/{p.stem}" for p in teachers]), encoding="utf-8")
     (out / "_config.yml").write_text(student_config((root / "_config.yml").read_text(encoding="utf-8")),
                                      encoding="utf-8")
     return out
