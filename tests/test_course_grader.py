@@ -119,3 +119,19 @@ def test_bad_arguments_say_what_is_allowed(course, tmp_path):
     with pytest.raises(SystemExit):                                 # the command line: a usage line and a message
         main(["course", "grade", "tiny", str(tmp_path), "--course", str(tmp_path / "none"), "--report",
               str(tmp_path / "r")])
+
+
+def test_prepare_executes_the_chapters_into_a_cache_of_their_own(tmp_path, monkeypatch):
+    from pgae_lite.course.prepare import chapters, prepare_course
+
+    monkeypatch.setenv("PGAE_LITE_PROFILE", "smoke")
+    assert [p.stem for p in chapters()][:2] == ["01_simulator", "02_dataset"]       # the book's order
+    seconds = prepare_course(tmp_path / "class", names=["02_dataset"], progress=False)
+    assert list(seconds) == ["02_dataset"]
+    executed = json.loads((tmp_path / "class" / "executed" / "02_dataset.ipynb").read_text(encoding="utf-8"))
+    assert any(c.get("outputs") for c in executed["cells"] if c["cell_type"] == "code")
+    assert any((tmp_path / "class" / "cache").rglob("*"))                 # what the chapter recorded, there
+    with pytest.raises(ArgumentError, match="the chapters are: 01_simulator"):
+        prepare_course(tmp_path / "class", names=["02_datset"])
+    with pytest.raises(ArgumentError, match="empty text"):
+        prepare_course(" ")
