@@ -162,6 +162,9 @@ def test_the_student_book_shows_an_executed_copys_outputs_and_the_handout_none(t
         (executed / path.name).write_text(json.dumps(nb), encoding="utf-8")
     out = write_student_edition(tmp_path / "student", executed=executed)
     for path in NOTEBOOKS:
+        if instructor_only(json.loads(path.read_text(encoding="utf-8"))):
+            assert not (out / "notebooks" / path.name).exists()          # the teachers' page: not there
+            continue
         book = json.loads((out / "notebooks" / path.name).read_text(encoding="utf-8"))
         handout = json.loads((out / "handout" / path.name).read_text(encoding="utf-8"))
         assert any(c.get("outputs") for c in book["cells"]), path.name
