@@ -276,5 +276,5 @@ def run(component: Callable[[], nn.Module], seed: int = 0, profile: Profile | st
             "train_seconds": seconds}
 
 
-__all__ = ["BASELINE", "FIGURES", "REFERENCE", "STUDENT_NAME", "TITLE", "WIDTHS", "WRONG", "check", "heldout_bce",
-           "lab_frames", "run"]
+__all__ = ["BASELINE", "FIGURES", "HalfWidths", "REFERENCE", "STUDENT_NAME", "TITLE", "WIDTHS", "WRONG", "check",
+           "heldout_bce", "lab_frames", "run"]

@@ -12,7 +12,7 @@ lab trains for 20 epochs (:data:`EPOCHS`), a class period on a laptop's CPU (``r
 
 A student's bottleneck is a factory ``factory(action_dim, language_dim, hidden_dim) -> nn.Module``
 whose ``forward(f_action, f_language)`` returns ``(h, z)``, as ``model.gmu`` of PGAE. :func:`check`
-judges it by its behaviour (:func:`pgae_lite.exercises.check_bottleneck`: alone, then inside a small
+judges it by its behaviour (:func:`pgae_lite.exercises.model.check_bottleneck`: alone, then inside a small
 PGAE, forward and backward) and by its structure (one linear map over [f_act; f_lang], no gate, h
 reading both features, the tanh). :func:`run` trains PGAE with it; :func:`train_at_budget` is the
 training the GRU lab shares.

@@ -124,7 +124,7 @@ REFERENCE = GRU
 def run(component: Callable[[int, int, int], nn.Module], seed: int = 0, profile=None,
         progress: bool = False) -> dict[str, float]:
     """PGAE with ``component(input_size, hidden_size, num_layers)`` as every recurrent layer, trained for
-    :data:`EPOCHS` epochs: describe's accuracy, execute's nRMSE (%) and the model's parameters."""
+    ``EPOCHS`` epochs: describe's accuracy, execute's nRMSE (%) and the model's parameters."""
     if not callable(component):
         raise ArgumentTypeError("component must be a class or function that builds the recurrent layer, "
                                 f"component(input_size, hidden_size, num_layers); got {shown(component)}")
