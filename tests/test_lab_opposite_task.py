@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 
-import pytest
 import torch
 
 from pgae_lite.course.labs import lab as lab_module
@@ -27,13 +26,6 @@ def test_the_reference_passes_on_other_seeds_and_sizes():
     for seed, batch, steps in ((0, 6, 12), (1, 9, 100), (2, 2, 3)):
         result = lab.check(lab.REFERENCE, seed=seed, batch=batch, steps=steps)
         assert result, str(result)
-
-
-@pytest.mark.parametrize("mistake", list(lab.WRONG))
-def test_each_wrong_component_gets_its_diagnosis(mistake):
-    component, words = lab.WRONG[mistake]
-    result = lab.check(component)
-    assert not result and words in str(result), str(result)
 
 
 def test_the_untouched_handout_and_other_mistakes_are_named():

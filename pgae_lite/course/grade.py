@@ -51,6 +51,7 @@ class Grade:
     possible: dict[str, float]
     status: str = "graded"                   # graded | timed out | not graded
     messages: list[str] = field(default_factory=list)
+    results: dict = field(default_factory=dict)  # the grader's results, in Gradescope's format
 
     @property
     def total(self) -> float:
@@ -164,22 +165,24 @@ def run_one(notebook: Path, autograder: Path, timeout: float = TIMEOUT) -> tuple
 
 
 def grade_one(student: str, notebook: Path, autograder: Path, possible: dict[str, float],
-              timeout: float = TIMEOUT) -> tuple[Grade, dict]:
-    """One student's :class:`Grade` and their Gradescope results."""
+              timeout: float = TIMEOUT) -> Grade:
+    """One student's :class:`Grade`, their Gradescope results in it."""
     grade = Grade(student, {q: 0.0 for q in possible}, dict(possible))
     results, problem = run_one(notebook, autograder, timeout)
     if results is None:
         grade.status = "timed out" if problem.startswith("stopped") else "not graded"
         grade.messages.append(problem)
         tests = [{"name": q, "score": 0.0, "max_score": p, "output": problem} for q, p in possible.items()]
-        return grade, {"score": 0.0, "output": problem, "tests": tests}
+        grade.results = {"score": 0.0, "output": problem, "tests": tests}
+        return grade
+    grade.results = results
     for test in results.get("tests", []):
         name = test.get("name")
         if name in possible and test.get("score") is not None:
             grade.points[name] = float(test["score"])
             if grade.points[name] < possible[name]:
                 grade.messages.append(f"{name}: {_failure(test.get('output', ''))}")
-    return grade, results
+    return grade
 
 
 def write_reports(grades: list[Grade], possible: dict[str, float], report: Path) -> Path:
@@ -208,21 +211,19 @@ def grade_folder(name: str, folder: str | os.PathLike, autograder: str | os.Path
     work = submissions(folder, name)
     (report / "gradescope").mkdir(parents=True, exist_ok=True)
     grades: list[Grade] = []
-    results_of: dict[str, dict] = {}
     with tempfile.TemporaryDirectory(prefix="pgae-grade-backup-") as backup:
         guard = Guard([folder, autograder.parent], Path(backup))
         for student, notebook in work.items():
             start = time.perf_counter()
-            grade, results = grade_one(student, notebook, autograder, possible, timeout)
+            grade = grade_one(student, notebook, autograder, possible, timeout)
             harmed = guard.restore()
             if harmed:
                 grade.messages.append("changed or deleted files it was not given, put back: "
                                       + ", ".join(p.name for p in harmed))
             grades.append(grade)
-            results_of[student] = results
-            for who, their in results_of.items():    # all again after each: a stop, or a submission that
-                atomic_write_text(report / "gradescope" / f"{who}.json",   # deleted them, loses nothing
-                                  json.dumps(their, indent=1) + "\n")
+            for g in grades:                  # all again after each: a stop, or a submission that
+                atomic_write_text(report / "gradescope" / f"{g.student}.json",   # deleted them, loses nothing
+                                  json.dumps(g.results, indent=1) + "\n")
             write_reports(grades, possible, report)
             if progress:
                 print(f"{student}: {grade.total:g}/{sum(possible.values()):g} ({grade.status}, "

@@ -74,13 +74,11 @@ def grade_course(out: str | Path, names: list[str] | None = None, timeout: float
                               out / "reports" / name, timeout, progress)
         seconds = time.perf_counter() - start
         possible = questions(course / "autograder" / f"{name}.zip")
-        outputs = {g.student: json.loads((out / "reports" / name / "gradescope" / f"{g.student}.json")
-                                         .read_text(encoding="utf-8")) for g in grades}
         report["assignments"][name] = {
             "possible": sum(possible.values()), "questions": possible,
             "seconds_per_submission": round(seconds / len(grades), 1),
             "grades": {g.student: {"total": g.total, "status": g.status, "message": " | ".join(g.messages),
-                                   "diagnosed": all(w in json.dumps(outputs[g.student], ensure_ascii=False)
+                                   "diagnosed": all(w in json.dumps(g.results, ensure_ascii=False)
                                                     for w in expected.get(g.student, []))}
                        for g in grades}}
     return report

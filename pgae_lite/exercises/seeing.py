@@ -57,6 +57,17 @@ def _given(model: ChannelSeparatedCAE, blocked: str, hint: str) -> ChannelSepara
     return given
 
 
+def _ask(title: str, student: Callable, seed: int, method: str, hint: str) -> tuple:
+    """Run ``student(model, images)`` on a seeded untrained CAE whose ``method`` is blocked (it is what the
+    student writes): ``(result, model, images, what model.method gives, what the student's gave)``."""
+    result = CheckResult(title)
+    images, model = _images(seed), _model(seed)
+    result.note(f"input: an untrained ChannelSeparatedCAE in eval mode and uint8 frames {images.shape}")
+    expected = getattr(model, method)(images)
+    out = _call(result, f"your {title.split()[-1]}", student, _given(model, method, hint), images.copy())
+    return result, model, images, expected, out
+
+
 def _tensors(out: Any, n: int) -> list | None:
     """``out`` as a list when it is a list or tuple of ``n`` items, else None."""
     return list(out) if isinstance(out, (list, tuple)) and len(out) == n else None
@@ -122,12 +133,8 @@ def check_cae_loss(student: Callable, seed: int = 0) -> CheckResult:
     ``model`` is a :class:`~pgae_lite.cae.ChannelSeparatedCAE`: use ``model.red``, ``model.green``,
     ``model.blue`` (each has ``encode`` and ``logits``), not ``model.loss``.
     """
-    result = CheckResult("CAE loss")
-    images, model = _images(seed), _model(seed)
-    result.note(f"input: an untrained ChannelSeparatedCAE in eval mode and uint8 frames {images.shape}")
-    expected = model.loss(images)
-    given = _given(model, "loss", "compute each channel's BCE with model.red, model.green and model.blue")
-    out = _call(result, "your loss", student, given, images.copy())
+    result, model, images, expected, out = _ask(
+        "CAE loss", student, seed, "loss", "compute each channel's BCE with model.red, model.green and model.blue")
     if out is RAISED:
         return result
     got = _tensors(out, 2)
@@ -175,12 +182,9 @@ def check_visual_features(student: Callable, seed: int = 0) -> CheckResult:
     Use ``model.red.encode``, ``model.green.encode``, ``model.blue.encode`` (each takes (B, 1, 120, 160)
     in [0, 1]), not ``model.encode``.
     """
-    result = CheckResult("visual features v_t")
-    images, model = _images(seed), _model(seed)
-    result.note(f"input: an untrained ChannelSeparatedCAE in eval mode and uint8 frames {images.shape}")
-    expected = model.encode(images)                                          # (B, 30)
-    given = _given(model, "encode", "encode each channel with model.red, model.green, model.blue and join them")
-    out = _call(result, "your features", student, given, images.copy())
+    result, model, images, expected, out = _ask(                             # expected: (B, 30)
+        "visual features", student, seed, "encode",
+        "encode each channel with model.red, model.green, model.blue and join them")
     if out is RAISED:
         return result
     if isinstance(out, torch.Tensor) and out.shape == (BATCH, 3, model.config.features):
