@@ -12,9 +12,10 @@ import pytest
 
 from pgae_lite.config import PROFILE_ENV, get_profile
 
-# Every chapter but the results page and the teachers' page, which only read result files (no profile, no seed).
+# Every chapter but the results page, the teachers' page and the contributors' notes, which only read result files
+# (no profile, no seed).
 NOTEBOOKS = sorted(p for p in (Path(__file__).resolve().parent.parent / "notebooks").glob("*.ipynb")
-                   if p.stem not in ("A2_results", "A5_teaching"))
+                   if p.stem not in ("A2_results", "A5_teaching", "A6_engineering"))
 
 
 def settings_cell(path: Path) -> str:
