@@ -8,10 +8,13 @@ and raises :class:`~pgae_lite.data.dataset.DataFormatError` naming what was expe
 when anything is missing or malformed: a file and its line for a short or long
 row, a value that is not a finite number or lies far outside the data's range,
 a language row that is not one-hot (:mod:`pgae_lite.data.checks`), and a
-``vocabulary.txt`` whose words differ from :data:`pgae_lite.world.words.VOCABULARY`.
+``vocabulary.txt`` whose words differ from :data:`pgae_lite.world.words.VOCABULARY`, a file named
+``target*.txt`` whose name holds no pattern number, and a sample whose length is not its speed's
+(100 steps slow, 50 fast).
 """
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -63,6 +66,7 @@ def load_original(path: str | Path) -> PGAEDataset:
     for split in ("train", "test"):
         for date_dir in sorted((target / f"behavior_{split}").iterdir()):
             for f in sorted(date_dir.glob("target*.txt")):
+                pattern = _pattern_of(f)
                 rel = f"{date_dir.name}/{f.stem}"
                 joints = read_rows(f, 5)
                 check_range(f, joints, *JOINT_BOUNDS, "joint")
@@ -81,9 +85,9 @@ def load_original(path: str | Path) -> PGAEDataset:
                     raise DataFormatError(f"{lang_file}: a language file has 40 "
                                           "one-hot rows (8 x 5), found "
                                           f"{lang.shape[0]}")
-                pattern = int(f.stem.replace("target", ""))
                 if pattern not in pattern_info:
                     raise DataFormatError(f"{rel}: pattern {pattern} not listed in actions.txt")
+                _check_steps(f, n, PATTERNS[pattern])
                 words = _descriptions(lang_file, lang, pattern)
                 action, arrangement, split_name = pattern_info[pattern]
                 if split_name != split:
@@ -105,6 +109,25 @@ def load_original(path: str | Path) -> PGAEDataset:
     order = np.argsort(rows["ids"], kind="stable")  # by date, then pattern: a fixed order
     arrays = {k: np.asarray(v)[order] for k, v in rows.items()}
     return PGAEDataset(**arrays, source=f"original:{root}")
+
+
+def _pattern_of(path: Path) -> int:
+    """The pattern number in a sample's file name, ``target<number>.txt``; a file of another name among the samples
+    is refused, naming it, rather than read as a sample or passed over (it may be a renamed one)."""
+    found = re.fullmatch(r"target([0-9]{1,6})", path.stem)
+    if not found:
+        raise DataFormatError(f"{path} is not a sample's file: the authors name each sample target<pattern number>"
+                              f".txt (target000017.txt); rename it so, or move it out of {path.parent}")
+    return int(found.group(1))
+
+
+def _check_steps(path: Path, steps: int, pattern: Pattern) -> None:
+    """A sample must last its speed's steps: the authors record every slow action in 100 steps and every fast
+    one in 50 (Pattern.steps; all 864 of their samples do), so another count is a damaged or foreign file."""
+    if steps != pattern.steps:
+        raise DataFormatError(f"{path}: pattern {pattern.number} is {pattern.code}, which the authors record in "
+                              f"{pattern.steps} steps (slow actions {MAX_STEPS}, fast ones {MAX_STEPS // 2}); "
+                              f"found {steps}")
 
 
 def _read_vision(path: Path) -> np.ndarray:

@@ -25,6 +25,8 @@ CELLS = ("lstm", "peephole")
 JOINT_FEEDBACKS = ("start", "predicted")
 #: The optional parts of a ModelConfig, each None or a Part.
 PARTS = ("language", "crossmodal", "binding")
+#: h of the plain recipe (PGAE's GMU output), as in the authors' code.
+HIDDEN = 50
 
 
 def whole(owner: str, name: str, value, low: int, meaning: str = "") -> None:
@@ -58,6 +60,9 @@ class Part:
 
     kind: ClassVar[str] = "part"
     slot: ClassVar[str] = ""
+    #: The width h (ModelConfig.hidden) a model with this part has when its ModelConfig does not give one
+    #: (None: the plain recipe's, :data:`HIDDEN`).
+    hidden: ClassVar[int | None] = None
 
     def check(self, owner) -> None:
         """Raise a ValueError if this part cannot go with the rest of ``owner`` (the config holding it)."""
@@ -73,7 +78,9 @@ class ModelConfig:
 
     units: int = 100
     layers: int = 2
-    hidden: int = 50     # h: the GMU's output (PGAE), the transformer's width (PTAE), each code (PRAE, PVAE)
+    # h: the GMU's output (PGAE), the transformer's width (PTAE), each code (PRAE, PVAE). None: the width its
+    # parts are built for (Part.hidden: PTAE's 128, which its 4 heads divide), else HIDDEN (50).
+    hidden: int | None = None
     cell: str = "lstm"   # "peephole" = the paper's cell; "lstm" = fused nn.LSTM (faster)
     # Deviation from paper: "start" = the action decoder reads the start joints at every step instead of
     # its own previous prediction ("predicted", the paper's; see pgae.ActionDecoder).
@@ -97,6 +104,9 @@ class ModelConfig:
     binding: Part | None = None       # None: one model for every signal
 
     def __post_init__(self):
+        if self.hidden is None:          # a default that works with every part given (PTAE's heads divide it)
+            self.hidden = next((part.hidden for part in (getattr(self, name) for name in PARTS)
+                                if isinstance(part, Part) and part.hidden), HIDDEN)
         for name in ("units", "layers", "hidden"):
             whole("ModelConfig", name, getattr(self, name), 1)
         if self.cell not in CELLS:
@@ -123,4 +133,4 @@ class ModelConfig:
         return d | {name: None if d[name] is None else d[name].to_dict() for name in PARTS}
 
 
-__all__ = ["CELLS", "JOINT_FEEDBACKS", "ModelConfig", "PARTS", "Part", "check_part", "flag", "whole"]
+__all__ = ["CELLS", "HIDDEN", "JOINT_FEEDBACKS", "ModelConfig", "PARTS", "Part", "check_part", "flag", "whole"]

@@ -50,6 +50,9 @@ class CrossmodalConfig(Part):
 
     kind: ClassVar[str] = "crossmodal-transformer"
     slot: ClassVar[str] = "crossmodal"
+    # Deviation from paper: the book's PTAE is 128 wide (PTAE: 256), the width ModelConfig takes when it gives
+    # none; 4 heads divide it (ModelConfig's plain 50 they do not).
+    hidden: ClassVar[int] = 128
     heads: int = 4
     # Deviation from paper: a feed-forward of 512 (PTAE: 1024), no dropout (PTAE: 0.25), and the frames read
     # with their positions (PTAE: none; push and pull visit the same poses in opposite orders). Each change
@@ -68,7 +71,8 @@ class CrossmodalConfig(Part):
     def check(self, owner: ModelConfig) -> None:
         if owner.hidden % self.heads:
             raise ValueError(f"the crossmodal transformer splits its width (hidden={owner.hidden}) among "
-                             f"{self.heads} heads: hidden must be a multiple of heads")
+                             f"{self.heads} heads: hidden must be a multiple of heads, e.g. "
+                             f"{self.heads * max(1, round(owner.hidden / self.heads))}")
         if owner.language is not None:
             raise ValueError(f"the crossmodal transformer reads the words as tokens itself; a language encoder "
                              f"({owner.language!r}) needs the GMU (ModelConfig crossmodal=None)")
@@ -176,7 +180,7 @@ class PTAE(LearnsFromSignals, nn.Module):
 
     def __init__(self, cfg: ModelConfig | None = None, lexicon: Lexicon = DEFAULT_LEXICON):
         super().__init__()
-        self.cfg = cfg or ModelConfig(hidden=128, crossmodal=CrossmodalConfig())
+        self.cfg = cfg or ModelConfig(crossmodal=CrossmodalConfig())       # 128 wide (CrossmodalConfig.hidden)
         if self.cfg.crossmodal is None:
             raise ValueError("PTAE is the crossmodal transformer: its ModelConfig needs crossmodal=CrossmodalConfig()")
         self.lexicon = lexicon

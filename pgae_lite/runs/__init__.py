@@ -7,7 +7,9 @@
 - ``reproduce``   every row of Table 1 (and the family's) over seeds (``python -m pgae_lite reproduce``)
 - ``sweep``       many trainings as tasks on a Dask cluster, from a laptop to a lab's cluster
 - ``sweep_worker`` every worker of a sweep set up for these trainings (one thread, malloc thresholds)
+- ``scheduler``   which Dask cluster a sweep runs on: its address checked, reached, with workers, before any data
 - ``results``     the committed result files, read and quoted by the book and the README
+- ``result_checks`` what a result file may hold: plain text, finite figures in their measure's range
 - ``tables``      the chapters' tables of result files: the family's, the two-view ablation
 - ``departures``  the book's recipe against the paper's, each departure with its measured effect
 """

@@ -18,20 +18,26 @@ The files are found in the repository (:func:`repository`: an explicit ``root``,
 ``$PGAE_LITE_REPOSITORY``, else the first folder at or above the working directory that holds
 ``results/`` and ``_toc.yml``), never beside the package's source, which an installed package
 does not have. Superseded files lie in ``results/history/`` and are named ``history/NAME``.
+
+Every value read is checked before it is rendered (:mod:`pgae_lite.runs.result_checks`): text that
+renders as itself, finite numbers of a sane size, each figure in its measure's range (an accuracy
+in [0, 100], an nRMSE in [0, 100]); a failure is a :class:`ResultFileError` naming the file and the key.
+``python -m pgae_lite.runs.results --readme`` (:func:`write_readme`) rewrites the README's headline
+table atomically; a failure to read or write it is one sentence and leaves the README as it was.
 """
 from __future__ import annotations
 
 import json
 import os
 import re
-import sys
 from pathlib import Path
 
 import pandas as pd
 
+from pgae_lite.runs.result_checks import ResultFileError, check_figures, count_of, number_of, seeds_of, text_of
 from pgae_lite.runs.rows import TABLE1_ROWS
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import atomic_write_text
+from pgae_lite.util.storage import OutputError, atomic_write_text
 from pgae_lite.world.words import TEST_SIGNALS
 
 RESULTS_ENV = "PGAE_LITE_RESULTS"          # a results folder alone (tests)
@@ -40,54 +46,6 @@ REPOSITORY_ENV = "PGAE_LITE_REPOSITORY"    # the repository's root
 
 class RepositoryNotFoundError(PGAELiteError, FileNotFoundError):
     """No repository (a folder holding ``results/`` and ``_toc.yml``) where it was looked for."""
-
-
-class ResultFileError(PGAELiteError, ValueError):
-    """A result file that is damaged, or holds what must not be rendered (one sentence naming the file)."""
-
-
-# Text rendered into Markdown or HTML: no table cell separator, no tag, no backquote, no generated-block marker,
-# no line break and no other control character (U+0085, U+2028 and U+2029 break lines too).
-_MARKUP = re.compile(r"[|<>`\x00-\x1f\x7f-\x9f\u2028\u2029]")
-# Outside a code span, also no emphasis, link, escape or entity.
-_INLINE = re.compile(r"[|<>`\x00-\x1f\x7f-\x9f\u2028\u2029*_\[\]\\&]")
-
-
-def text_of(value, where: str, code: bool = False) -> str:
-    """``value`` when it is a string that renders as itself in Markdown (``code``: in a code span);
-    else a :class:`ResultFileError`."""
-    if not isinstance(value, str):
-        raise ResultFileError(f"{where} must be a string; got {type(value).__name__} {value!r:.60}")
-    found = (_MARKUP if code else _INLINE).search(value)
-    if found:
-        raise ResultFileError(f"{where} holds markup ({found.group(0)!r}: "
-                              "a table separator, tag, backquote, line break, control character, emphasis, link "
-                              f"or entity), which would not render as itself; got {value!r:.80}")
-    return value
-
-
-def number_of(value, where: str) -> float:
-    """``value`` when it is a finite number (not a bool); else a :class:`ResultFileError`."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not abs(value) <= sys.float_info.max:
-        raise ResultFileError(f"{where} must be a finite number; got {value!r:.60}")
-    return float(value)
-
-
-def count_of(value, where: str) -> str:
-    """``value`` as text when it is a whole number >= 1 (cores, threads) or a plain string; else a ResultFileError."""
-    if isinstance(value, str):
-        return text_of(value, where)
-    if not isinstance(value, int) or isinstance(value, bool) or value < 1:
-        raise ResultFileError(f"{where} must be a whole number >= 1 or a plain text; got {value!r:.60}")
-    return str(value)
-
-
-def seeds_of(value, where: str) -> list[int]:
-    """``value`` when it is a non-empty list of whole numbers >= 0; else a :class:`ResultFileError`."""
-    if not isinstance(value, list) or not value or \
-            not all(isinstance(s, int) and not isinstance(s, bool) and s >= 0 for s in value):
-        raise ResultFileError(f"{where} must be a list of whole numbers >= 0 (the seeds); got {value!r:.60}")
-    return value
 
 
 def repository(root: str | Path | None = None) -> Path:
@@ -122,8 +80,8 @@ def names() -> list[str]:
         sorted(f"history/{p.stem}" for p in (folder / "history").glob("*.json"))
 
 
-def load(name: str) -> dict:
-    """The whole result file ``results/<name>.json``."""
+def _read(name: str) -> dict:
+    """The whole result file ``results/<name>.json`` as written, checked to be a result file only."""
     path = results_dir() / f"{name}.json"
     if not path.is_file():
         raise FileNotFoundError(f"no result file {path}; the result files are: {', '.join(names()) or 'none'} "
@@ -135,9 +93,20 @@ def load(name: str) -> dict:
     except json.JSONDecodeError as e:
         raise ResultFileError(f"{path} is not valid JSON (line {e.lineno}, column {e.colno}: {e.msg}); "
                               "write it again with its benchmark") from None
+    except ValueError:                                  # Python's limit on the digits of a whole number
+        raise ResultFileError(f"{path} holds a number of thousands of digits, which no benchmark writes; "
+                              "write it again with its benchmark") from None
     if not isinstance(result, dict) or not isinstance(result.get("data"), dict):
         raise ResultFileError(f"{path} is not a result file: it must be a JSON object with a 'data' object "
                               "(benchmarks/harness.py writes them)")
+    return result
+
+
+def load(name: str) -> dict:
+    """The whole result file ``results/<name>.json``, every number in it finite, of a sane size and in its
+    measure's range (:mod:`pgae_lite.runs.result_checks`)."""
+    result = _read(name)
+    check_figures(result, f"{name}.json")
     return result
 
 
@@ -184,8 +153,9 @@ def measured(name: str) -> str:
 
 
 def table1_rows(name: str) -> dict[str, dict]:
-    """The rows of a ``benchmarks/table1.py`` result, each one of :data:`~pgae_lite.runs.rows.TABLE1_ROWS`."""
-    data = load(name)["data"].get("rows")
+    """The rows of a ``benchmarks/table1.py`` result, each one of :data:`~pgae_lite.runs.rows.TABLE1_ROWS`
+    (each figure is checked where it is read, :func:`table1_frame`)."""
+    data = _read(name)["data"].get("rows")
     if not isinstance(data, dict) or not data:
         raise ResultFileError(f"{name}.json: data.rows must be an object with one entry per row of Table 1 "
                               f"({', '.join(TABLE1_ROWS)}); got {data!r:.60}")
@@ -203,10 +173,10 @@ def _cell(name: str, row: str, r: dict, what: str, signal: str, key: str) -> flo
     where, figure = f"{name}.json: rows[{row!r}]", f"{signal} {key} {what}"
     try:
         if what == "paper":
-            return number_of(r["paper"][signal][0 if key == "accuracy" else 1], f"{where} {figure}")
+            return number_of(r["paper"][signal][0 if key == "accuracy" else 1], f"{where} {figure}", key)
         if what == "median":
-            return number_of(r["stats"][signal][key]["median"], f"{where} {figure}")
-        per_seed = [number_of(s[signal][key], f"{where} {signal} {key} of a seed") for s in r["seeds"].values()]
+            return number_of(r["stats"][signal][key]["median"], f"{where} {figure}", key)
+        per_seed = [number_of(s[signal][key], f"{where} {signal} {key} of a seed", key) for s in r["seeds"].values()]
     except (KeyError, IndexError, TypeError, AttributeError):
         raise ResultFileError(f"{where} lacks the {figure}") from None
     if not per_seed:
@@ -330,7 +300,33 @@ def readme_with_headline(readme: str) -> str:
     return f"{head}{README_START}{first_line}\n{headline_table()}\n{README_END}{tail}"
 
 
-if __name__ == "__main__":
+def write_readme(root: str | Path | None = None) -> Path:
+    """Rewrite the repository's README.md with :func:`readme_with_headline`, atomically; every failure (a damaged
+    result file or README, a README that is a link, a full disk, a read-only checkout) is one sentence (a
+    :class:`~pgae_lite.util.errors.PGAELiteError`; misplaced markers, a ValueError) and leaves the README as it was."""
+    readme = repository(root) / "README.md"
+    if readme.is_symlink():                             # a write never goes through a link
+        raise OutputError(f"refusing to rewrite {readme}: it is a symbolic link (to {os.readlink(readme)}); "
+                          "put the README itself in its place")
+    if not readme.is_file():
+        raise OutputError(f"no README to rewrite at {readme}: the headline table is written into the "
+                          "repository's README.md, which must exist")
+    try:
+        text = readme_with_headline(readme.read_text(encoding="utf-8"))
+    except PGAELiteError:                               # a damaged result file: its own sentence
+        raise
+    except UnicodeDecodeError:
+        raise OutputError(f"{readme} is not text (UTF-8); restore it from the repository") from None
+    except OSError as e:
+        raise OutputError(f"cannot read {readme}: {e.strerror or e}; the README is unchanged") from None
+    except ValueError as e:                             # misplaced markers: say which file
+        raise ValueError(f"{readme}: {e}") from None
+    atomic_write_text(readme, text)                     # OutputError, and the old file whole, if it fails
+    return readme
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``python -m pgae_lite.runs.results --readme``: rewrite README.md's headline table; an error is one line."""
     import argparse
 
     parser = argparse.ArgumentParser(prog="python -m pgae_lite.runs.results",
@@ -338,13 +334,15 @@ if __name__ == "__main__":
     parser.add_argument("--readme", action="store_true", required=True, help="rewrite the README's headline table")
     parser.add_argument("--root", default=None, help=f"the repository (default: ${REPOSITORY_ENV}, else the "
                                                      "folder at or above here with results/ and _toc.yml)")
-    args = parser.parse_args()
+    args = parser.parse_args(argv)
     try:
         root = repository(args.root)
         os.environ[REPOSITORY_ENV] = str(root)          # every file below is read from this repository
-        readme = root / "README.md"
-        text = readme_with_headline(readme.read_text(encoding="utf-8"))
-    except (PGAELiteError, ValueError, OSError) as e:   # a damaged file or README: one line, no traceback
+        readme = write_readme(root)
+    except (PGAELiteError, ValueError, OSError) as e:   # a damaged file, README or disk: one line, no traceback
         parser.exit(2, f"error: {e}\n")
-    atomic_write_text(readme, text)                     # never left half-written
     print(f"{readme}: headline table rewritten from {results_dir() / 'table1-original.json'}")
+
+
+if __name__ == "__main__":
+    main()

@@ -17,6 +17,7 @@ to is on the book's results page (appendix A2), not in these comments.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, fields
 
 from pgae_lite.data.normaliser import check_vision_scaling
@@ -46,6 +47,21 @@ def number(owner: str, name: str, value, low: float, high: float = math.inf, *, 
         bound = f"> {low}" if above else f">= {low}"
         bound += f" and <= {high}" if high != math.inf else ""
         raise ValueError(f"{owner} {name} must be a number {bound}{' or None' if optional else ''}; got {value!r}")
+
+
+def signal_probs_of(value) -> tuple[float, ...]:
+    """``value`` as a tuple of floats when it holds one finite number >= 0 per signal (words.SIGNALS) and they sum
+    to 1; else a ValueError (NaN, a text, a flag or a single number included)."""
+    try:
+        items = () if isinstance(value, (str, bytes, dict)) else tuple(value)
+    except TypeError:                                   # a single number: not one per signal
+        items = ()
+    ok = len(items) == len(SIGNALS) and all(
+        isinstance(q, numbers.Real) and not isinstance(q, bool) and 0 <= q <= 1 for q in items)   # NaN: False
+    if not ok or abs(sum(items) - 1) > 1e-6:
+        raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1 (finite: no NaN), "
+                         f"one per signal in the order {', '.join(SIGNALS)}; got {value!r:.120}")
+    return tuple(float(q) for q in items)
 
 
 @dataclass(slots=True)     # a setting it does not have is an error, not a new attribute
@@ -111,11 +127,7 @@ class TrainConfig:
             raise ValueError(f"unknown schedule {self.schedule!r}; the options are: {', '.join(SCHEDULES)}")
         for name in ("length_batches", "signals_per_sample", "teacher_language"):
             flag("TrainConfig", name, getattr(self, name))
-        probs = tuple(float(q) for q in self.signal_probs)
-        if len(probs) != len(SIGNALS) or min(probs) < 0 or abs(sum(probs) - 1) > 1e-6:
-            raise ValueError(f"signal_probs must be {len(SIGNALS)} non-negative numbers summing to 1, one per "
-                             f"signal in the order {', '.join(SIGNALS)}; got {self.signal_probs}")
-        self.signal_probs = probs
+        self.signal_probs = signal_probs_of(self.signal_probs)
         check_vision_scaling(self.vision_scaling)
         for name in ("epochs", "batch_size", "checkpoint_every"):
             whole("TrainConfig", name, getattr(self, name), 1)
@@ -130,4 +142,4 @@ class TrainConfig:
         return d | {name: None if d[name] is None else d[name].to_dict() for name in TRAIN_PARTS}
 
 
-__all__ = ["RECIPE_VERSION", "SCHEDULES", "TRAIN_PARTS", "TrainConfig", "number"]
+__all__ = ["RECIPE_VERSION", "SCHEDULES", "TRAIN_PARTS", "TrainConfig", "number", "signal_probs_of"]

@@ -25,6 +25,7 @@ import torch
 
 from pgae_lite.model.config import Part
 from pgae_lite.model.signals import DESCRIBE, EXECUTE, REPEAT_ACTION, REPEAT_BOTH, REPEAT_LANGUAGE, sample_signals
+from pgae_lite.world.words import SIGNALS
 
 #: What a share counts: the PTAE authors' reading (a share of the updates), or a fixed labelled subset.
 READINGS = ("updates", "samples")
@@ -51,15 +52,29 @@ class SupervisionConfig(Part):
             raise ValueError(f"SupervisionConfig of must be one of {', '.join(READINGS)} (a share of the updates, "
                              f"or a fixed share of the samples); got {self.of!r}")
 
+    def check(self, owner) -> None:
+        """Refuse ``owner``'s (a TrainConfig's) signal_probs when they give no weight to the paired signals or to
+        the unimodal ones: a paired step, or an unpaired one, would have nothing to draw."""
+        for keep in (PAIRED, UNIMODAL):
+            restricted(owner.signal_probs, keep)
+
 
 def restricted(probs: tuple[float, ...], keep: tuple[int, ...]) -> tuple[float, ...]:
     """``probs`` with every signal outside ``keep`` set to 0, renormalised to sum to 1."""
     kept = [q if i in keep else 0.0 for i, q in enumerate(probs)]
     total = sum(kept)
     if total <= 0:
-        raise ValueError(f"signal_probs give no weight to any of the signals {keep}; "
-                         "limited supervision needs both paired and unimodal signals")
+        kind = "paired" if keep == PAIRED else "unimodal" if keep == UNIMODAL else "kept"
+        raise ValueError(f"signal_probs give no weight to any of the signals {_named(keep)} (the {kind} ones), so "
+                         f"limited supervision would train on no {kind} step; give weight to at least one of them, "
+                         f"and to one of the {'unimodal' if keep == PAIRED else 'paired'} signals "
+                         f"({_named(UNIMODAL if keep == PAIRED else PAIRED)})")
     return tuple(q / total for q in kept)
+
+
+def _named(signals: tuple[int, ...]) -> str:
+    """The names of ``signals`` (indices into words.SIGNALS), joined."""
+    return ", ".join(SIGNALS[i] for i in signals)
 
 
 def labelled_samples(count: int, share: float, seed: int) -> torch.Tensor:
