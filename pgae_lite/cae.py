@@ -297,14 +297,14 @@ def _train_loop(model: ChannelSeparatedCAE, optimiser: torch.optim.Optimizer, im
 
 
 def load_cae(path: str | Path, device: torch.device | str | None = None) -> tuple[ChannelSeparatedCAE, dict]:
-    """A trained CAE (in eval mode) and its checkpoint's other contents.
+    """A trained CAE (in eval mode) and its checkpoint's other contents, through the checks of every saved file
+    (:func:`~pgae_lite.util.storage.load_torch`: finite weights; :func:`~pgae_lite.util.storage.config_from`:
+    known settings; :func:`~pgae_lite.util.storage.load_state`: the expected tensors), each failure one sentence."""
+    from pgae_lite.util.storage import config_from, load_state
 
-    Read with ``weights_only=True``; a damaged or foreign file raises
-    :class:`~pgae_lite.util.storage.CorruptCheckpointError`.
-    """
-    ckpt = load_torch(path, ("model", "config", "data", "history"), "CAE checkpoint")
-    model = ChannelSeparatedCAE(CAEConfig.from_dict(ckpt["config"]))
-    model.load_state_dict(ckpt["model"])
+    ckpt = load_torch(path, ("model", "config", "data", "history"), "CAE checkpoint", finite=("model",))
+    config = CAEConfig.from_dict(asdict(config_from(CAEConfig, ckpt["config"], path, "CAE settings")))
+    model = load_state(ChannelSeparatedCAE(config), ckpt["model"], path, "CAE")
     return model.to(device or default_device()).eval(), ckpt
 
 

@@ -173,9 +173,11 @@ def test_the_training_loop_reaches_no_pretrained_encoder_and_no_free_form_langua
 
 
 def test_plumbing_imports_nothing_above_it():
-    assert reachable("pgae_lite.util.storage") == {"pgae_lite.util.errors"}
+    assert reachable("pgae_lite.util.storage") == {"pgae_lite.util.errors", "pgae_lite.util.atomic_files",
+                                                   "pgae_lite.util.folder_lock"}
     assert not reachable("pgae_lite.util.errors")
-    assert reachable("pgae_lite.world.patterns") == {"pgae_lite.world.words", "pgae_lite.util.errors", "pgae_lite.util"}
+    assert reachable("pgae_lite.world.patterns") == {"pgae_lite.world.words", "pgae_lite.world.typed",
+                                                     "pgae_lite.util.errors", "pgae_lite.util"}
     assert "pgae_lite.runs.reproduce" not in reachable("pgae_lite.runs.pipeline")
     assert "pgae_lite.robot.instructions" not in reachable("pgae_lite.robot.closedloop")
 

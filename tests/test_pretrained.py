@@ -173,6 +173,7 @@ def test_cache_is_reused_and_a_damaged_file_recomputed(encoder, tmp_path):
                    {"embeddings": saved["embeddings"][:10]}, {"embeddings": saved["embeddings"] * np.nan}):
         torch.save({**saved, **change}, other)
         assert encoder.read_cache(other) is None, change
+    assert encoder.read_cache(tmp_path) is None                    # a folder where the file should be
     torch.save(saved, other)
     assert torch.equal(encoder.read_cache(other)[0], saved["embeddings"])
 

@@ -8,7 +8,7 @@
 // Python's. tests/test_page_logic.py runs these functions against Python's own answers
 // (parity.json, pgae_lite/web/parity.py) in a headless browser; pgae.js runs the models.
 //
-//   window.pgaeLogic.make(manifest) -> {say, readTyped, choose, inputs, decode, choices, ...}
+//   window.pgaeLogic.make(manifest) -> {say, normaliseTyped, readTyped, choose, inputs, decode, choices, ...}
 (function () {
   "use strict";
   // Python's whitespace (str.split(), str.strip()): JavaScript's \s less U+FEFF, plus U+001C-U+001F, U+0085.
@@ -73,6 +73,12 @@
       return value;
     }
 
+    // pgae_lite.world.typed.normalise_typed: marks(NFKC(marks(text))), the marks' table written by Python
+    // (manifest.typed.marks: each character -> what it is read as).
+    const MARKS = m.typed.marks;
+    const marks = (s) => { let out = ""; for (const ch of s) out += Object.hasOwn(MARKS, ch) ? MARKS[ch] : ch; return out; };
+    const normaliseTyped = (text) => marks(marks(String(text)).normalize("NFKC"));
+
     // pgae_lite.world.words: normalise_signal, tokenize, parse_description
     function normaliseSignal(signal) {
       const key = strip(String(signal).replace(new RegExp(`[${WHITE}_:-]+`, "gu"), " ")).toLowerCase();
@@ -80,7 +86,8 @@
       return key;
     }
     function tokenize(text) {
-      const words = split(text.toLowerCase().split(vocab[0].toLowerCase()).join(" ").replace(/[.,;:!?]/g, " "));
+      const read = normaliseTyped(text);                              // as typed: curly marks, odd spaces, fullwidth
+      const words = split(read.toLowerCase().split(vocab[0].toLowerCase()).join(" ").replace(/[.,;:!?]/g, " "));
       const tokens = [], unknown = [];
       for (let i = 0; i < words.length; i++) {
         const pair = words.slice(i, i + 2).join("-");
@@ -239,7 +246,7 @@
     }
     const [lo, hi] = m.joint_units, toData = (v) => (v + 1) * (hi - lo) / 2 + lo;   // [-1, 1] -> the data's units
 
-    return {say, wholeNumber, normaliseSignal, tokenize, parseDescription, readTyped, inputText, scenePattern,
+    return {say, wholeNumber, normaliseTyped, normaliseSignal, tokenize, parseDescription, readTyped, inputText, scenePattern,
             patternOf, patternFor, findEpisode, inputs, recorded, decode, choices, isCorrect, actedOn, nrmse, target,
             toData,
             pyrepr, pyvalue, strip};

@@ -127,16 +127,18 @@
   // The words of a text, as pgae_lite.freeform.word_lookup splits them: letters, inner apostrophes.
   const WORD = /[\p{L}\p{Nl}\p{No}]+(?:'[\p{L}\p{Nl}\p{No}]+)*/gu;
 
-  // The text as a model's encoder reads it (encoder.read_as): the variant's unknown words replaced.
+  // The text as a model's encoder reads it (encoder.read_as): the variant's unknown words replaced, in the
+  // text's plain form (its lookup reads the text as typed.normalise_typed gives it; L.normaliseTyped).
   async function readAs(name, text) {
     await load();
-    if (manifest.models[name]?.reads !== "features") return text;
+    if (manifest.models[name]?.reads !== "features" || !manifest.models[name].words) return text;
     const words = await wordTable(name);
-    return text.replace(WORD, w => words[w.toLowerCase()] || w);
+    return L.normaliseTyped(text).replace(WORD, w => words[w.toLowerCase()] || w);
   }
   // The words of a text the lookup replaces, [word, replacement] in the text's order (lookup.replacements).
   async function replacements(name, text) {
     const words = await wordTable(name);
+    text = L.normaliseTyped(text);
     return [...new Set(text.match(WORD) || [])].filter(w => words[w.toLowerCase()])
       .map(w => [w, words[w.toLowerCase()]]);
   }
@@ -193,6 +195,7 @@
   // understood the model's readback or null.
   async function refusal(model, text, scene = null, understood = null) {
     await load();
+    text = L.normaliseTyped(text);                                    // as typed (refusal reads its plain form)
     const rule = await refusalRule(model);
     return rule.refusal(text, await readAs(model, text), await replacements(model, text), scene,
                         understood === null ? null : readback(understood));
@@ -217,7 +220,7 @@
     const [arrangement, action, variation] = place(args);
     L.scenePattern(arrangement, action);
     const signal = L.normaliseSignal(args.signal ?? "execute"), s = manifest.signals.indexOf(signal);
-    const text = L.strip(args.text == null ? "" : String(args.text)), route = args.route ?? (m.route || "direct");
+    const text = L.strip(L.normaliseTyped(args.text == null ? "" : String(args.text))), route = args.route ?? (m.route || "direct");
     const routes = manifest.play.routes;                                // instructions.check_route
     if (!routes.includes(route)) throw new Error(L.say("unknown_route", {route: L.pyvalue(route),
                                                                          routes: routes.map(L.pyrepr).join(", ")}));

@@ -84,6 +84,9 @@ def tokens_to_text(row: torch.Tensor | list[int]) -> str:
     for t in torch.as_tensor(row).tolist():
         if t == EOS:
             break
+        if not isinstance(t, int) or not 0 <= t < SIGNAL_TOKEN + len(SIGNALS):
+            raise LanguageError(f"tokens_to_text reads token ids 0-{SIGNAL_TOKEN + len(SIGNALS) - 1} (the words, "
+                                f"then the {len(SIGNALS)} signals); got {t!r:.40}")
         words.append(SIGNALS[t - SIGNAL_TOKEN] if t >= SIGNAL_TOKEN else VOCABULARY[t])
     # Deviation from paper: the authors' code fed "execute: push red slowly" (its vocabulary's
     # signal words end in a colon) and kept hyphens; the colon adds nothing, and "move up" reads
@@ -178,8 +181,8 @@ def cached_token_vectors(tf: Transformer, texts: list[str], what: str, dtype: to
     path = cache_dir() / "embeddings" / f"{what}-{'top-input' if top_input else 'tokens'}-{key}.pt"
     if path.exists():
         try:
-            saved = load_torch(path, ("states", "mask"), what=f"{what} token cache")
-            if saved["states"].shape[:2] == saved["mask"].shape and saved["states"].isfinite().all():
+            saved = load_torch(path, ("states", "mask"), what=f"{what} token cache", finite=("states",))
+            if saved["states"].shape[:2] == saved["mask"].shape:
                 return saved["states"], saved["mask"]
         except CorruptCheckpointError:       # damaged: computed again, never trusted
             pass
@@ -272,14 +275,14 @@ class PretrainedLanguageEncoder(LanguageEncoderBase):
 
     def read_cache(self, path: Path) -> tuple[torch.Tensor, float] | None:
         """The table and its compute time from a cache file; None if it is missing, damaged or another's."""
-        try:
-            saved = torch.load(path, map_location="cpu", weights_only=True)
-            table = saved["embeddings"]
-            if (all(saved.get(k) == v for k, v in self._cache_header().items())
-                    and table.shape == (len(self.texts), self.output_dim) and table.isfinite().all()):
-                return table.float(), float(saved["seconds"])
-        except Exception:  # noqa: BLE001 -- unreadable or not what we wrote: recomputed, never trusted
+        try:       # the checks every saved file gets (util/storage.load_torch), the weights finite
+            saved = load_torch(path, ("embeddings", "seconds"), what="sentence-vector cache", finite=("embeddings",))
+        except CorruptCheckpointError:       # damaged or not what we wrote: recomputed, never trusted
             return None
+        table = saved["embeddings"]
+        if (all(saved.get(k) == v for k, v in self._cache_header().items()) and isinstance(table, torch.Tensor)
+                and table.shape == (len(self.texts), self.output_dim)):
+            return table.float(), float(saved["seconds"])
         return None
 
     def _load_or_compute_table(self) -> tuple[torch.Tensor, str, float]:

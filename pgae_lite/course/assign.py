@@ -21,6 +21,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from pgae_lite.util.checks import output_folder
 from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -58,17 +59,9 @@ def choose(names: list[str] | None, course: Path = COURSE) -> dict[str, Path]:
 
 
 def check_out(out: str | os.PathLike) -> Path:
-    """``out``, resolved, once known to be a folder this module may write into: new, empty, or one it made."""
-    if not str(out).strip():
-        raise ArgumentError("the output folder is empty text; give a folder to write the course into")
-    out = Path(out).expanduser().resolve()
-    if out == ROOT or ROOT in out.parents:
-        raise ArgumentError(f"{out} is inside the repository; write the course outside it (e.g. ~/pgae-course)")
-    if out.exists() and not out.is_dir():
-        raise ArgumentError(f"{out} is a file, not a folder")
-    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).exists():
-        raise ArgumentError(f"{out} already holds files this command did not write; choose a new or empty folder")
-    return out
+    """``out``, resolved, once known to be a folder this module may write into: new, empty, or one it made
+    (:func:`~pgae_lite.util.checks.output_folder`, the check of every output folder)."""
+    return output_folder("the output folder", out, "course assign", marker=MARKER, outside={"the repository": ROOT})
 
 
 def prepare_out(out: str | os.PathLike) -> Path:

@@ -6,11 +6,17 @@ Not in the paper: a course built on it. The three steps a teacher types, each a 
     python -m pgae_lite course assign COURSE [NAME ...]                 # the notebooks to hand out, the autograders
     python -m pgae_lite course grade NAME SUBMISSIONS --course COURSE --report REPORT   # scores.csv, Gradescope
 
-Arguments are checked before anything runs; a bad one gets a usage line and a message (``__main__``).
+Arguments are checked before anything runs (the folders by :func:`~pgae_lite.util.checks.output_folder` and
+:func:`~pgae_lite.util.checks.input_folder`, as every command's); a bad one gets a usage line and a message
+(``__main__``).
 """
 from __future__ import annotations
 
 import argparse
+import re
+
+#: What ``course grade`` writes into its report folder: a folder holding only these is one it wrote.
+GRADE_WRITES = ("scores.csv", "gradescope")
 
 
 def add_parser(sub, profiles: tuple[str, ...]) -> None:
@@ -68,12 +74,20 @@ def run(args: argparse.Namespace) -> int:
         print(f"course written to {out}: hand out {out / 'handout'}; keep {out / 'autograder'} private")
         return 0
     from pgae_lite.course.grade import TIMEOUT, grade_folder
+    from pgae_lite.util.checks import input_folder, output_folder, positive_number
 
-    autograder = Path(args.course).expanduser().resolve() / "autograder" / f"{args.name}.zip"
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]*", args.name):
+        raise ArgumentError(f"NAME {args.name!r} is not an assignment's name (letters, digits, '_', '-' and '.', "
+                            "e.g. ps3_model); the names are those of the autograders `course assign` wrote")
+    submissions = input_folder("SUBMISSIONS", args.submissions, "folder of submitted notebooks")
+    course = input_folder("--course", args.course, "course folder (the one `course assign` wrote)")
+    report = output_folder("--report", args.report, "course grade", written=GRADE_WRITES,
+                           outside={"the submissions folder": submissions})
+    timeout = TIMEOUT if args.timeout is None else positive_number("--timeout", args.timeout)
+    autograder = course / "autograder" / f"{args.name}.zip"
     if not autograder.is_file():
         raise ArgumentError(f"no autograder for {args.name!r} at {autograder}; run python -m pgae_lite course "
                             f"assign {args.course} first")
-    grades = grade_folder(args.name, args.submissions, autograder, args.report,
-                          TIMEOUT if args.timeout is None else args.timeout)
-    print(f"{len(grades)} submissions graded: {Path(args.report).expanduser().resolve() / 'scores.csv'}")
+    grades = grade_folder(args.name, submissions, autograder, report, timeout)
+    print(f"{len(grades)} submissions graded: {report / 'scores.csv'}")
     return 0

@@ -21,10 +21,12 @@ from pathlib import Path
 
 import yaml
 
+from pgae_lite.util.checks import output_folder
 from pgae_lite.util.errors import ArgumentError, PGAELiteError
 
 ROOT = Path(__file__).resolve().parents[2]
 TIMEOUT = 3600                              # seconds a chapter may run (the longest takes minutes)
+WRITES = ("cache", "executed")              # what it writes into its folder: a folder holding only these is its own
 
 
 class PrepareError(PGAELiteError):
@@ -54,11 +56,7 @@ def choose(names: list[str] | None, root: Path = ROOT) -> list[Path]:
 def prepare_course(out: str | os.PathLike, profile: str | None = None, names: list[str] | None = None,
                    progress: bool = True) -> dict[str, float]:
     """Execute the chosen chapters into ``out`` (see the module's docstring); seconds per chapter."""
-    if not str(out).strip():
-        raise ArgumentError("the output folder is empty text; give a folder for the class's cache")
-    out = Path(out).expanduser().resolve()
-    if out.exists() and not out.is_dir():
-        raise ArgumentError(f"{out} is a file, not a folder")
+    out = output_folder("the output folder", out, "course prepare", written=WRITES)
     todo = choose(names)
     cache, executed = out / "cache", out / "executed"
     executed.mkdir(parents=True, exist_ok=True)

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import yaml
 
+from pgae_lite.util.checks import output_folder
 from pgae_lite.util.errors import PGAELiteError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -127,15 +128,14 @@ def student_config(text: str) -> str:
     return yaml.safe_dump(wanted, sort_keys=False, allow_unicode=True)
 
 
-def _check_out(out: Path, root: Path) -> None:
-    if out == root or root in out.parents:
-        raise PGAELiteError(f"the student edition goes outside the repository, not into {out}: "
-                            "choose a folder elsewhere, e.g. /tmp/student")
-    if out.exists() and not out.is_dir():
-        raise PGAELiteError(f"{out} is a file, not a folder: choose a new folder for the student edition")
-    if out.is_dir() and any(out.iterdir()) and not (out / MARKER).is_file():
-        raise PGAELiteError(f"{out} is a non-empty folder that this command did not make: choose a new or "
-                            "empty folder, so that none of your files is overwritten")
+def _check_out(out: str | os.PathLike, root: Path) -> Path:
+    """``out`` resolved, once :func:`~pgae_lite.util.checks.output_folder` (every output folder's check) allows it:
+    outside the repository, and new, empty or written by this module before."""
+    try:
+        return output_folder("the student edition's folder", out, "student-edition", marker=MARKER,
+                             outside={"the repository": root})
+    except PGAELiteError as e:            # this module's errors, as before: one line "error: ..." on the command line
+        raise PGAELiteError(str(e)) from None
 
 
 def _code(nb: dict) -> list[str]:
@@ -164,8 +164,8 @@ def write_student_edition(out: Path, root: Path = ROOT, executed: Path | None = 
     ``handout/`` holds the notebooks students get, without solutions or outputs. ``notebooks/`` holds the
     book's chapters, the same; with ``executed`` (a folder of the chapters executed, each under its own
     name) they keep its outputs, so the student book shows what each chapter computed."""
-    out, root = Path(out).expanduser().resolve(), Path(root).resolve()
-    _check_out(out, root)
+    root = Path(root).resolve()
+    out = _check_out(out, root)
     every = sorted((root / "notebooks").glob("*.ipynb"))
     teachers = [p for p in every if instructor_only(json.loads(p.read_text(encoding="utf-8")))]
     chapters = [p for p in every if p not in teachers]

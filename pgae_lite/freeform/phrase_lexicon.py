@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields, replace
 
 from pgae_lite.util.checks import instance_of
 from pgae_lite.util.errors import ArgumentError
-from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, SYNONYMS, VOCABULARY
+from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS, SYNONYMS, VOCABULARY, LanguageError
 
 SLOTS = ("action", "colour", "speed")
 #: The meanings each slot may say.
@@ -129,7 +129,10 @@ def _entries(value) -> list[str]:
 
 
 def words_of(text: str) -> list[str]:
-    """Lower-case words of ``text``; hyphens and punctuation split words."""
+    """Lower-case words of ``text``; hyphens and punctuation split words. ``text`` must be a string."""
+    if not isinstance(text, str):
+        raise LanguageError(f"the text must be a string, e.g. 'push the red cube'; got {type(text).__name__} "
+                            f"{text!r:.80}")
     return re.findall(r"[a-z']+", text.lower())
 
 

@@ -34,7 +34,7 @@ from pgae_lite.freeform.phrase_lexicon import PHRASING_WORDS, PhraseLexicon, tra
 from pgae_lite.freeform.phrasings import phrasings, phrasings_digest
 from pgae_lite.model.config import Part, whole
 from pgae_lite.model.signals import LANG_IN, SignalBatch
-from pgae_lite.util.storage import cache_dir, config_digest, load_torch, save_torch
+from pgae_lite.util.storage import CorruptCheckpointError, cache_dir, config_digest, load_torch, save_torch
 from pgae_lite.world.words import CANONICAL, SIGNALS, SLOTS, VOCABULARY
 
 MEANINGS = tuple(itertools.product(*SLOTS))                       # 36 (action, colour, speed)
@@ -108,9 +108,13 @@ class PhrasingBank:
             key = config_digest({"texts": self.texts, "encoder": encoder.transformer.digest,
                                  "pooling": encoder.pooling})
             path = cache_dir() / "embeddings" / f"phrasings-{key}.pt"
+            vectors = None
             if path.exists():
-                vectors = load_torch(path, ("vectors",), what="phrasing cache")["vectors"]
-            else:
+                try:            # the checks every saved file gets, the vectors finite
+                    vectors = load_torch(path, ("vectors",), what="phrasing cache", finite=("vectors",))["vectors"]
+                except CorruptCheckpointError:          # damaged: computed again, never trusted
+                    vectors = None
+            if not isinstance(vectors, torch.Tensor) or vectors.dim() != 2 or len(vectors) != len(self.texts):
                 vectors = encoder._run_transformer(self.texts)          # (S·36·K, D), once
                 save_torch({"vectors": vectors}, path)
             self.vectors = vectors.reshape(*shape, -1).to(device)        # (S, 36, K, D)

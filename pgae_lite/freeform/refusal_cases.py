@@ -43,6 +43,26 @@ REFUSED = [
     ("push the black cube", "I know no black cube"),
     ("rotate the red cube", "I can't 'rotate' a cube"),
     ("the red cube, please", "I can push"),
+    # as a phone types them (typed.normalise_typed): a curly apostrophe, a zero-width space, a soft hyphen
+    ("don\u2019t push the red cube", "what not to do"),
+    ("do\u200bn't push the red cube", "what not to do"),
+    ("don\u00adt push the red cube", "what not to do"),
+    ("\uff44\uff4f\uff4e\uff07\uff54 push the red cube", "what not to do"),
+    # more than one cube, more than one act, two opposite ways, a negated speed
+    ("push every cube", "more than one cube ('every')"),
+    ("push both cubes slowly", "more than one cube ('both')"),
+    ("pull all of them", "more than one cube ('all')"),
+    ("push the two cubes", "more than one cube ('cubes')"),
+    ("push the red cube twice", "more than once ('twice')"),
+    ("give the red cube three pushes", "more than once ('three pushes')"),
+    ("slide the blue cube back and forth", "more than once ('back and forth')"),
+    ("slide the red cube left and right", "two opposite ways ('left', 'right')"),
+    ("move the blue cube forward and back", "two opposite ways ('forward', 'back')"),
+    ("push and pull the red cube", "2 actions"),
+    ("could you please not be slow and push the red cube", "what speed not to use"),
+    ("forget pushing the blue cube", "what not to do"),
+    ("spin the red cube right away", "I can't 'spin' a cube"),  # "right away": a time, not the way "away"
+    ("x" * 1001, "is too long"),
 ]
 
 #: Acted on in :data:`SCENE`.
@@ -52,6 +72,16 @@ NOT_REFUSED = [
     "push the red cube slowly, not fast",
     "go ahead and pull the red cube quickly",                 # a frame's "and" is not a second step
     "Carefully and slowly nudge the scarlet cube away from yourself",
+    "don\u2019t forget to push the red cube",                 # negations that still ask for one act
+    "can\u2019t you push the red cube?",
+    "won't you pull the blue cube slowly?",
+    "why don't you slide the red block",
+    "do not hesitate to push the blue cube",
+    "never mind the blue one, push the red cube",
+    "forget the blue cube, pull the red one",
+    "\uff50\uff55\uff53\uff48 the red cube\u00a0fast",             # fullwidth letters, a non-breaking space
+    "pull the red cube back right away",                      # "right away": no side, no second way
+    "push the red cube all the way forward",
 ]
 
 #: Without a scene only the words are judged: (text, a part of the reason or None).
@@ -60,10 +90,11 @@ WITHOUT_SCENE = [
     ("don't push the green cube", "what not to do"),
 ]
 
-#: The readback is judged only where the words name no colour: (text, readback, a part of the reason or None).
+#: The readback's colour is judged whether or not the words name one: (text, readback, a part of the reason or None).
 READBACK = [
     ("shove the thing away fast", "push yellow fast", "I understood 'push yellow fast'"),
-    ("push the red cube fast", "push yellow fast", None),
+    ("push the red cube fast", "push yellow fast", "I understood 'push yellow fast'"),   # named or not
+    ("push the red cube fast", "push red fast", None),
 ]
 
 

@@ -12,19 +12,29 @@ understood of it and from the scene (the two cubes on the table):
   speeds it names;
 - the model's own readback (``repeat language``): the description it took the text to mean.
 
-Refused, with the reason in one sentence (:class:`CannotDo`)::
+The text is first read as typed (:func:`~pgae_lite.world.typed.normalise_typed`: curly apostrophes,
+zero-width and fullwidth characters); idioms of time ("right away") and a clause that sets a cube aside
+("never mind the blue one, ...") are left out. Refused, with the reason in one sentence (:class:`CannotDo`)::
 
+    too long        more than MOST_CHARACTERS characters (the encoder would read only their start)
     negation        a negator (not, never, n't, no, stop, avoid, ...) whose clause goes on
                     to name an action or a cube ("don't push the red cube"; a negated manner,
-                    "no rush", is only left out)
-    more than one   two actions (by their verbs), two cubes or two speeds named, or two sentences or steps
+                    "no rush", is only left out; "can't you ...?", "don't forget to ..." ask for the act)
+    negated speed   a speed negated, and no other named ("please not be slow and push ...")
+    more than one   two actions (by their verbs), two cubes or two speeds named, a word over several
+                    cubes ("both", "every", "the cubes"), a repetition ("twice", "two pushes"), two
+                    opposite ways ("forward and back", "left and right"), or two sentences or steps
                     ("..., then ...") that each name an action
-    absent cube     a colour named, or the readback's colour, that is not on the table
     outside colour  a colour word (WordNet: a kind of colour) read as none of the world's six
-    outside action  no action of the world named at all (the verbs it names, if any, are said)
+    outside action  no action of the world named at all (the verbs it names, if any, are said); or an
+                    action read only by the word lookup from a word of no action of the world
+                    (``lift`` -> ``haul``) with no direction of that action beside it
+    absent cube     a colour named, or the readback's colour, that is not on the table
 
-The closed classes of words below are English grammar, written for this purpose; the
-rule reads the lexicon, WordNet and the scene, never a test sentence.
+The closed classes of words are English grammar, written for this purpose
+(:mod:`pgae_lite.freeform.refusal_words`); the rule reads the lexicon, WordNet and the scene,
+never a test sentence. What the world can do is the phrase lexicon's (``LEXICON``: its actions'
+verbs and directions), whatever a model's training held of it.
 """
 from __future__ import annotations
 
@@ -33,16 +43,28 @@ import re
 from dataclasses import replace
 from functools import lru_cache
 
-from pgae_lite.freeform.phrase_lexicon import MEANINGS, PhraseLexicon, training_lexicon, words_of
+from pgae_lite.freeform.phrase_lexicon import LEXICON, MEANINGS, PhraseLexicon, training_lexicon, words_of
 from pgae_lite.freeform.phrasings import phrasings, slot_meanings
-from pgae_lite.freeform.word_lookup import WordLookup, wordnet
+from pgae_lite.freeform.refusal_words import (
+    MOST_CHARACTERS,
+    NEGATORS,
+    SEQUENCERS,
+    direction_table,
+    directions,
+    dismissed,
+    is_negator,
+    opposite_ways,
+    quantified,
+    repetition,
+    without_idioms,
+)
+from pgae_lite.freeform.word_lookup import WordLookup, base_forms, wordnet
+from pgae_lite.util.checks import instance_of
+from pgae_lite.util.errors import ArgumentError, ArgumentTypeError
 from pgae_lite.world.patterns import Pattern
+from pgae_lite.world.typed import normalise_typed
 from pgae_lite.world.words import COLOURS, LanguageError, parse_description
 
-#: Words that negate what follows them in their clause (and any word ending in n't).
-NEGATORS = frozenset("not never no nor neither nothing nobody stop avoid refrain dont cannot".split())
-#: Words that start a further step of a sequence.
-SEQUENCERS = frozenset("then afterwards afterward later next finally also".split())
 # A clause ends at punctuation or at a word that joins clauses.
 _CLAUSE_END = re.compile(r"[,.;:!?]|\b(?:and|but|or|then|while|before|after)\b", re.IGNORECASE)
 # A sentence or step ends at a full stop or semicolon, or where a sequencing word begins the next.
@@ -61,6 +83,13 @@ MESSAGES: dict[str, str] = {
     "several_cubes": "{count} cubes ({named})",
     "several_speeds": "{count} speeds ({named})",
     "several_steps": "{count} steps",
+    "several_cubes_said": "more than one cube ({word})",
+    "repeated": "the act more than once ({words})",
+    "opposite_ways": "two opposite ways ({named})",
+    "negated_speed": "I can't do {text}: it says what speed not to use ({negation}); tell me the speed, "
+                     "e.g. 'push the {colour} cube {speed}'",
+    "too_long": "an instruction of {count} characters is too long: I read at most {most}; tell me one "
+                "action on one cube, e.g. 'push the {colour} cube'",
     "no_such_colour": "I know no {word} cube: the cubes of this world are {colours} or {last}{and_scene}",
     "and_scene": ", and {scene}",
     "cannot_verb": "I can't '{verb}' a cube: I can {actions}",
@@ -114,18 +143,35 @@ def is_colour_word(word: str) -> bool:
     return any(s in _colour_kinds() for s in wordnet().synsets(word))
 
 
+def _set_aside(read: str, lexicon: PhraseLexicon) -> tuple[str, list[str]]:
+    """(``read`` with each clause that sets a cube aside blanked, the dismissals that name an action).
+
+    "never mind the blue one, push the red cube" -> " , push the red cube"; a dismissal of an action
+    ("forget pushing the red cube") is a negation of it."""
+    kept, acted, at = [], [], 0
+    ends = [m.span() for m in _CLAUSE_END.finditer(read)] + [(len(read), len(read))]
+    for start, end in ends:
+        clause = read[at:start]
+        if dismissed(clause) and slot_meanings(clause, lexicon)["action"]:
+            acted.append(" ".join(words_of(clause)))
+        kept.append(" " * len(clause) if dismissed(clause) else clause)
+        kept.append(read[start:end])
+        at = end
+    return "".join(kept), acted
+
+
 def _negated(read: str, lexicon: PhraseLexicon) -> tuple[list[str], list[str]]:
     """(the negations that name an action or a cube, the speeds negated) of the text ``read``."""
     refused, speeds = [], []
     for clause in _CLAUSE_END.split(read):
         words = words_of(clause)
-        at = next((i for i, w in enumerate(words) if w in NEGATORS or w.endswith("n't")), None)
+        at = next((i for i in range(len(words)) if is_negator(words, i)), None)
         if at is None:
             continue
         scope = slot_meanings(" ".join(words[at + 1:]), lexicon)
         if scope["action"] or scope["colour"]:
             refused.append(" ".join(words[at:]))
-        speeds += scope["speed"]
+        speeds += [(s, " ".join(words[at:])) for s in scope["speed"]]
     return refused, speeds
 
 
@@ -141,8 +187,30 @@ def _more_than_one(read: str, said: dict, lexicon: PhraseLexicon, negated_speeds
     for key, named in (("several_actions", by_verbs), ("several_cubes", said["colour"]), ("several_speeds", speeds)):
         if len(set(named)) > 1:
             return MESSAGES[key].format(count=str(len(set(named))), named=", ".join(dict.fromkeys(named)))
+    word, again = quantified(read), repetition(read)
+    if word:
+        return MESSAGES["several_cubes_said"].format(word=repr(word))
+    if again:
+        return MESSAGES["repeated"].format(words=repr(again))
+    ways = opposite_ways(read, direction_table(lexicon))
+    if ways:
+        return MESSAGES["opposite_ways"].format(named=", ".join(map(repr, ways)))
     steps = [step for step in _STEP_END.split(read) if slot_meanings(step, lexicon)["action"]]
     return MESSAGES["several_steps"].format(count=str(len(steps))) if len(steps) > 1 else None
+
+
+@lru_cache(maxsize=1)
+def _world_action_words() -> frozenset:
+    """Every word of the full lexicon's action phrases: what the world can do, in words (``LEXICON``)."""
+    phrases = [p for ps in LEXICON.phrases("action").values() for p in ps] + list(LEXICON.neutral)
+    return frozenset(w for p in phrases for w in words_of(p))
+
+
+def looked_up_action(word: str, replacement: str, lexicon: PhraseLexicon) -> list[str]:
+    """The actions the lookup reads into ``word`` (its ``replacement``'s), where ``word`` is no word of the
+    world's actions (nor a form of one): ``lift`` -> ``haul``: [pull]; else []."""
+    acts = slot_meanings(replacement, lexicon)["action"]
+    return [] if not acts or base_forms(word.lower()) & _world_action_words() else acts
 
 
 def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swapped: dict[str, str],
@@ -155,30 +223,50 @@ def _outside_the_world(text: str, read: str, said: dict, lookup: WordLookup, swa
         return MESSAGES["no_such_colour"].format(word=outside[0], colours=", ".join(COLOURS[:-1]), last=COLOURS[-1],
                                                  and_scene=and_scene)
     if not said["action"]:
-        verbs = [w for w in dict.fromkeys(words_of(read)) if not lookup.is_known(w) and wordnet().synsets(w, pos="v")]
+        verbs = [w for w in dict.fromkeys(words_of(text)) if not lookup.is_known(w) and wordnet().synsets(w, pos="v")]
         if verbs:
             return MESSAGES["cannot_verb"].format(verb=verbs[0], actions=ACTIONS_SAID)
         return MESSAGES["cannot_do"].format(text=repr(text.strip()), actions=ACTIONS_SAID)
+    ways = {meaning for _, _, meaning, _ in directions(read, direction_table(lookup.lexicon))}
+    for word, replacement in swapped.items():               # the person's own word, judged as well
+        acts = looked_up_action(word, replacement, lookup.lexicon)
+        if acts and not set(acts) & ways:
+            return MESSAGES["cannot_verb"].format(verb=word.lower(), actions=ACTIONS_SAID)
     return None
 
 
 def _absent_cube(said: dict, lexicon: PhraseLexicon, swapped: dict[str, str], scene: tuple[str, str],
                  understood: str | None) -> str | None:
-    """A cube named (or, where the words name none, understood) that is not on the table; or None."""
-    named = said["colour"]
-    for colour in dict.fromkeys(named):
+    """A cube named, or understood (the readback's colour, whether or not the words name one), that is not
+    on the table; or None."""
+    for colour in dict.fromkeys(said["colour"]):
         if colour not in scene:
             word = next((w for w, v in swapped.items() if colour in slot_meanings(v, lexicon)["colour"]), None)
             as_read = MESSAGES["as_read"].format(word=word, colour=colour) if word else ""
             return MESSAGES["absent_cube"].format(colour=colour, as_read=as_read, scene=_scene_text(scene))
-    if understood is None or named:
+    if understood is None:
         return None
-    try:                                                  # the colour came from the transformer alone
+    try:                                                  # the colour the model said back
         colour = parse_description(understood)[1]
     except LanguageError:
         return None
     return None if colour in scene else \
         MESSAGES["understood_absent"].format(understood=repr(understood), colour=colour, scene=_scene_text(scene))
+
+
+def _checked(text, encoder, scene, understood) -> tuple[str, tuple[str, str] | None]:
+    """(``text`` as typed, in its plain form; ``scene`` as a pair), or a clear error for a wrong argument."""
+    text = normalise_typed(instance_of("text", text, str, "the instruction as typed (a string)"))
+    if not hasattr(encoder, "word_lookup"):
+        raise ArgumentTypeError(f"encoder must be a model's language encoder (with a word_lookup, None for "
+                                f"none); got {type(encoder).__name__}")
+    instance_of("understood", understood, str, "the model's readback (a string)", optional=True)
+    if scene is not None:
+        if not isinstance(scene, (tuple, list)) or len(scene) != 2 or not all(isinstance(c, str) for c in scene):
+            raise ArgumentError(f"scene must be the colours of the (left, right) cubes, a pair such as "
+                                f"('red', 'blue'), or None; got {type(scene).__name__} {scene!r:.80}")
+        scene = (scene[0], scene[1])
+    return text, scene
 
 
 def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood: str | None = None) -> str | None:
@@ -188,12 +276,22 @@ def refusal(text: str, encoder, scene: tuple[str, str] | None = None, understood
     ``scene``: the colours of the (left, right) cubes on the table, if known; ``understood``: the
     model's readback of the text (``repeat language``), if known.
     """
+    text, scene = _checked(text, encoder, scene, understood)
+    example = scene[0] if scene else COLOURS[0]
+    if len(text) > MOST_CHARACTERS:
+        return MESSAGES["too_long"].format(count=str(len(text)), most=str(MOST_CHARACTERS), colour=example)
     lookup, read, swapped = _reading(encoder, text)
-    negations, negated_speeds = _negated(read, lookup.lexicon)
+    read, dismissals = _set_aside(without_idioms(read), lookup.lexicon)   # "right away", "never mind X, ..." out
+    negations, negated = _negated(read, lookup.lexicon)
+    negations = dismissals + negations
     if negations:
-        return MESSAGES["negation"].format(text=repr(text.strip()), negation=repr(negations[0]),
-                                           colour=scene[0] if scene else COLOURS[0])
+        return MESSAGES["negation"].format(text=repr(text.strip()), negation=repr(negations[0]), colour=example)
     said = slot_meanings(read, lookup.lexicon)                         # the actions, cubes and speeds it names
+    negated_speeds = [s for s, _ in negated]
+    if negated and not [s for s in said["speed"] if s not in negated_speeds]:
+        other = [s for s in MEANINGS["speed"] if s not in negated_speeds]
+        return MESSAGES["negated_speed"].format(
+            text=repr(text.strip()), negation=repr(negated[0][1]), colour=example, speed=(other or ["slowly"])[0])
     several = _more_than_one(read, said, lookup.lexicon, negated_speeds)
     if several:
         return MESSAGES["one_at_a_time"].format(text=repr(text.strip()), several=several)
@@ -225,4 +323,4 @@ def check_instruction(text: str, encoder, scene: tuple[str, str] | None = None,
 
 
 __all__ = ["ACTIONS_SAID", "MESSAGES", "NEGATORS", "SEQUENCERS", "CannotDo", "check_instruction", "disagreement",
-           "refusal"]
+           "looked_up_action", "refusal"]

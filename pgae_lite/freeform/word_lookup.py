@@ -47,6 +47,7 @@ from dataclasses import asdict
 from functools import lru_cache
 
 from pgae_lite.freeform.phrase_lexicon import SLOTS, PhraseLexicon, words_of
+from pgae_lite.world.typed import normalise_typed
 from pgae_lite.world.words import SIGNALS, VOCABULARY
 
 #: Function words: never looked up (the closed classes of English, written for this purpose).
@@ -167,7 +168,10 @@ class WordLookup:
         return self._targets[word]
 
     def replacements(self, text: str) -> dict[str, str]:
-        """The unknown words of ``text`` that are read as another word: ``{"amethyst": "purple"}``."""
+        """The unknown words of ``text`` that are read as another word: ``{"amethyst": "purple"}``.
+
+        ``text`` is read as typed (:func:`~pgae_lite.world.typed.normalise_typed`): "don’t" is "don't"."""
+        text = normalise_typed(text)
         for word in _WORD.findall(text):
             if word not in self._read_as:                   # each word decided once (morphology, senses)
                 low = word.lower()
@@ -176,7 +180,9 @@ class WordLookup:
         return {word: self._read_as[word] for word in _WORD.findall(text) if self._read_as[word]}
 
     def rewrite(self, text: str) -> str:
-        """``text`` with its unknown words replaced: "slide the amethyst cube" -> "slide the purple cube"."""
+        """``text`` with its unknown words replaced: "slide the amethyst cube" -> "slide the purple cube"; the
+        text in its plain form (:func:`~pgae_lite.world.typed.normalise_typed`), which the encoder reads."""
+        text = normalise_typed(text)
         swap = self.replacements(text)
         return _WORD.sub(lambda m: swap.get(m.group(0), m.group(0)), text) if swap else text
 

@@ -145,6 +145,9 @@ def execute_paraphrases(model: PGAE, cae: ChannelSeparatedCAE, normaliser: Norma
     check_route(route)
     if limit is not None:
         whole_number("limit", limit, 1)
+    if closed and cae is None:
+        raise ValueError("the closed loop needs the CAE (cae=...), which reads each step's camera image; "
+                         "give it, or pass closed=False for the open loop only")
     paraphrases = load_paraphrases() if paraphrases is None else paraphrases
     subset = data.split(split)
     told = [paraphrase_of(int(p), variation_of(i), paraphrases) for p, i in zip(subset.pattern, subset.ids)]

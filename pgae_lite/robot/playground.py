@@ -57,6 +57,7 @@ from pgae_lite.util.checks import instance_of, whole_number
 from pgae_lite.util.errors import PGAELiteError
 from pgae_lite.world import patterns
 from pgae_lite.world.patterns import ACTION_SIDES, ARRANGEMENTS, Pattern, pattern_parts
+from pgae_lite.world.typed import normalise_typed
 from pgae_lite.world.words import (
     SIGNALS,
     VOCABULARY,
@@ -150,7 +151,7 @@ def play(model: PGAE, cae: ChannelSeparatedCAE | None, normaliser: Normaliser, d
     check_objects(model, cae, normaliser, data, config)
     scene_pattern(arrangement, action)                    # checks both
     instance_of("text", text, str, "a description (a string)", optional=True)
-    signal, text = normalise_signal(signal), (text or "").strip()
+    signal, text = normalise_signal(signal), normalise_typed(text or "").strip()   # as typed, read once (typed.py)
     check_route(route)
     if loop not in ("open", "closed", None):
         raise ValueError(f"unknown loop {loop!r}; the options are: 'open', 'closed', None")

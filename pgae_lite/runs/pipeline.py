@@ -35,12 +35,14 @@ from pgae_lite.train.config import TRAIN_PARTS, TrainConfig
 from pgae_lite.train.supervision import SupervisionConfig
 from pgae_lite.util.checks import instance_of
 from pgae_lite.util.storage import (
+    CheckpointMismatchError,
     CorruptCheckpointError,
     FolderBusyError,
+    OutputError,
     cache_dir,
     config_digest,
+    config_from,
     default_device,
-    load_torch,
 )
 
 if TYPE_CHECKING:
@@ -95,8 +97,13 @@ def trained_model(training: Training, profile: Profile, seed: int = 0, device: s
         # Damaged, or saved with other data statistics (the folder's name fixes the data and CAE, so an
         # older pgae_lite scaled them otherwise): trained again, like the CAE.
         except (CorruptCheckpointError, DataMismatchError) as e:
+            if not (folder / CHECKPOINT).is_file():      # a folder in its place: not ours to delete
+                raise
             warnings.warn(f"cached model not used, training it again: {e}", stacklevel=2)
-            (folder / CHECKPOINT).unlink()
+            try:
+                (folder / CHECKPOINT).unlink()
+            except OSError as gone:                     # a read-only cache: said, with what was wrong
+                raise OutputError(f"{e}; it cannot be trained again there: {gone.strerror or gone}") from None
 
 
 def train_when_free(dataset: PGAEDataset, prof: Profile, folder: Path, device: str | None, progress: bool,
@@ -177,24 +184,36 @@ def is_trained(training: Training, profile: Profile, seed: int, dataset: PGAEDat
         return False
 
 
-def _with_parts(settings: dict, parts: tuple[str, ...], where: str) -> dict:
+def _with_parts(settings, parts: tuple[str, ...], where: str, path: str | Path) -> dict:
     """A saved config's dict with each part's dict made its part again (by its kind)."""
+    if not isinstance(settings, dict):
+        raise CheckpointMismatchError(f"{path} holds no {where} (a {type(settings).__name__}, not a dict of "
+                                      "settings): it is not a pgae_lite checkpoint, or it was altered")
     out = dict(settings)
     for name in parts:
         if out.get(name) is not None:
-            kind = out[name].get("kind")
+            kind = out[name].get("kind") if isinstance(out[name], dict) else None
             if kind not in PART_KINDS:
-                raise ValueError(f"{where}: unknown part {name}={kind!r}; the parts are: {', '.join(PART_KINDS)}")
+                raise CheckpointMismatchError(f"{path}, {where}: unknown part {name}={kind!r}; the parts are: "
+                                              f"{', '.join(PART_KINDS)}")
             settings = {f.name for f in fields(PART_KINDS[kind])}       # not what its dict adds (kind, digests)
-            out[name] = PART_KINDS[kind](**{k: v for k, v in out[name].items() if k in settings})
+            out[name] = config_from(PART_KINDS[kind], {k: v for k, v in out[name].items() if k in settings},
+                                    path, f"the {name} part of {where}")
     return out
 
 
-def recipe_from_dict(recipe: dict) -> tuple[ModelConfig, TrainConfig]:
+def recipe_from_dict(recipe: dict, path: str | Path = "the recipe") -> tuple[ModelConfig, TrainConfig]:
     """The model's and the training's settings of a recipe saved as :meth:`~pgae_lite.config.Profile.to_dict`
-    wrote it (a checkpoint's)."""
-    model = ModelConfig(**_with_parts(recipe["model"], PARTS, "the model's settings"))
-    return model, TrainConfig(**_with_parts(recipe["train"], TRAIN_PARTS, "the training's settings"))
+    wrote it (a checkpoint's, read from ``path``): a setting this version does not know, or refuses, is a
+    :class:`~pgae_lite.util.storage.CheckpointMismatchError` that names it."""
+    if not isinstance(recipe, dict) or not {"model", "train"} <= set(recipe):
+        raise CheckpointMismatchError(f"{path} holds no recipe (the model's and the training's settings): it is "
+                                      "not a pgae_lite checkpoint, or it was altered")
+    model = config_from(ModelConfig, _with_parts(recipe["model"], PARTS, "the model's settings", path), path,
+                        "the model's settings")
+    train = config_from(TrainConfig, _with_parts(recipe["train"], TRAIN_PARTS, "the training's settings", path),
+                        path, "the training's settings")
+    return model, train
 
 
 def load_model(path: str | Path, device: "torch.device | str | None" = None, dataset: PGAEDataset | None = None,
@@ -207,13 +226,13 @@ def load_model(path: str | Path, device: "torch.device | str | None" = None, dat
     another number of threads, in another cache) give different features: a model fed another CAE's
     features produces nonsense without any error, so this raises a DataMismatchError instead.
     """
-    from pgae_lite.train.checkpoint import check_fitted_on, check_recipe_version, load_weights
+    from pgae_lite.train.checkpoint import MODEL_KEYS, check_fitted_on, load_checkpoint, load_weights
     from pgae_lite.world.words import DEFAULT_LEXICON
 
-    ckpt = load_torch(path, ("model", "profile", "normaliser"))
+    ckpt = load_checkpoint(path, MODEL_KEYS)            # the checks every saved file gets, and the recipe's version
     if dataset is not None:
         check_fitted_on(ckpt, dataset, path)
-    model_cfg, recipe = recipe_from_dict(check_recipe_version(ckpt["profile"], path))
+    model_cfg, recipe = recipe_from_dict(ckpt["profile"], path)
     model = load_weights(build_model(model_cfg, lexicon or DEFAULT_LEXICON), ckpt, path)
     model.at_step(recipe.epochs, recipe.epochs)                       # its training is over
     model.to(device or default_device()).eval()

@@ -18,12 +18,16 @@ from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.data.normaliser import Normaliser
 from pgae_lite.train.config import RECIPE_VERSION
 from pgae_lite.util.errors import PGAELiteError
-from pgae_lite.util.storage import CheckpointMismatchError, CorruptCheckpointError, load_torch, save_torch
+from pgae_lite.util.storage import CheckpointMismatchError, load_state, load_torch, save_torch
 
 CHECKPOINT = "checkpoint.pt"
 #: What every checkpoint written by :func:`save_checkpoint` holds.
 CHECKPOINT_KEYS = ("model", "optimiser", "generator", "torch_rng", "epoch", "history",
                    "profile", "normaliser", "seconds")
+#: What a saved model needs to be used (:func:`pgae_lite.runs.pipeline.load_model`): not the optimiser's state.
+MODEL_KEYS = ("model", "profile", "normaliser")
+#: What must hold finite numbers only: the weights, the optimiser's state, the data statistics.
+FINITE_KEYS = ("model", "optimiser", "normaliser")
 
 
 class DataMismatchError(PGAELiteError, ValueError):
@@ -50,13 +54,19 @@ def save_checkpoint(path: Path, model: nn.Module, optimiser: torch.optim.Optimiz
                 "normaliser": normaliser.state_dict(), "seconds": seconds}, path)
 
 
-def load_checkpoint(path: str | Path) -> dict:
-    """Read a checkpoint safely (``weights_only=True``: tensors and plain data only).
+def load_checkpoint(path: str | Path, keys: tuple[str, ...] = CHECKPOINT_KEYS) -> dict:
+    """Read a checkpoint (or a saved model: ``keys`` :data:`MODEL_KEYS`) through the checks every saved
+    file gets (:func:`~pgae_lite.util.storage.load_torch`: ``weights_only=True``, tensors and plain data only;
+    the keys; finite weights, optimiser state and statistics) and its recipe's version
+    (:func:`check_recipe_version`): the one reader of every model the book trains, the family's included.
 
-    An empty, truncated or foreign file raises
-    :class:`~pgae_lite.util.storage.CorruptCheckpointError` naming it.
+    A folder in its place, an empty, truncated or foreign file, or NaN weights raise
+    :class:`~pgae_lite.util.storage.CorruptCheckpointError`, another recipe version
+    :class:`~pgae_lite.util.storage.CheckpointMismatchError`, each naming the file.
     """
-    return load_torch(path, CHECKPOINT_KEYS)
+    ckpt = load_torch(path, keys, finite=FINITE_KEYS)
+    check_recipe_version(ckpt["profile"], path)
+    return ckpt
 
 
 def _same_numbers(a: list, b: list) -> bool:
@@ -92,22 +102,10 @@ def check_recipe_version(recipe, path: str | Path) -> dict:
 
 
 def load_weights(model: nn.Module, ckpt: dict, path: str | Path) -> nn.Module:
-    """``model`` with the checkpoint's weights: refused with a one-sentence error if any is NaN or infinite
-    (:class:`~pgae_lite.util.storage.CorruptCheckpointError`), or if they do not fit the model
-    (:class:`~pgae_lite.util.storage.CheckpointMismatchError`: another model's, or altered)."""
-    broken = [k for k, v in ckpt["model"].items() if torch.is_tensor(v) and v.is_floating_point()
-              and not torch.isfinite(v).all()]
-    if broken:
-        raise CorruptCheckpointError(f"{path} holds non-finite weights (NaN or infinite) in {', '.join(broken[:3])}"
-                                     f"{' ...' if len(broken) > 3 else ''}: the model cannot be used; train it again")
-    try:
-        model.load_state_dict(ckpt["model"])
-    except (RuntimeError, TypeError, AttributeError) as e:    # weights of another shape, another model's names
-        first = str(e).strip().splitlines()[0] if str(e).strip() else type(e).__name__
-        raise CheckpointMismatchError(f"{path} holds weights that do not fit the model its recipe describes "
-                                      f"({first[:160]}): it was written by another version of the package or "
-                                      "altered; train the model again") from None
-    return model
+    """``model`` with the checkpoint's weights (read by :func:`load_checkpoint`, which refuses NaN or infinite
+    ones): refused with a one-sentence :class:`~pgae_lite.util.storage.CheckpointMismatchError` naming the
+    tensors that are missing, foreign or of another shape (another model's weights, or altered)."""
+    return load_state(model, ckpt["model"], path)
 
 
 def check_fitted_on(ckpt: dict, dataset: PGAEDataset, path: str | Path, made_on: str = "") -> None:
@@ -120,5 +118,6 @@ def check_fitted_on(ckpt: dict, dataset: PGAEDataset, path: str | Path, made_on:
     check_trained_on(ckpt, fitted, path, dataset.source + (f"; the model was trained on {made_on}" if made_on else ""))
 
 
-__all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "check_fitted_on", "check_recipe_version",
+__all__ = ["CHECKPOINT", "CHECKPOINT_KEYS", "DataMismatchError", "FINITE_KEYS", "MODEL_KEYS",
+           "check_fitted_on", "check_recipe_version",
            "check_trained_on", "load_checkpoint", "load_weights", "save_checkpoint", "training_split"]

@@ -34,6 +34,7 @@ from pgae_lite.train.checkpoint import (
     check_recipe_version,
     check_trained_on,
     load_checkpoint,
+    load_weights,
     save_checkpoint,
     training_split,
 )
@@ -41,7 +42,13 @@ from pgae_lite.train.draws import Draws
 from pgae_lite.train.optimiser import lr_factor, parameter_groups
 from pgae_lite.train.supervision import labelled_samples
 from pgae_lite.util.errors import ArgumentError, PGAELiteError
-from pgae_lite.util.storage import CheckpointMismatchError, default_device, folder_lock, training_threads
+from pgae_lite.util.storage import (
+    CheckpointMismatchError,
+    OutputError,
+    default_device,
+    folder_lock,
+    training_threads,
+)
 from pgae_lite.world.words import SIGNALS
 
 
@@ -119,12 +126,13 @@ def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
     with training_threads(device):   # on the CPU a fixed thread count: the same model on any machine
         if out_dir is None:
             return _train(*args)
-        with folder_lock(out_dir):
-            return _train(*args)
+        with folder_lock(out_dir) as writable:      # not writable (a read-only cache): a finished model is read
+            return _train(*args, writable=writable)
 
 
 def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: torch.device,
-           progress: bool, model: nn.Module | None, callback, name: str, language) -> Trained:
+           progress: bool, model: nn.Module | None, callback, name: str, language,
+           writable: bool = True) -> Trained:
     cfg = profile.train
     cfg.__post_init__()              # checked again: a field may have been set since
     if cfg.phrasings is not None and language is None:
@@ -137,6 +145,10 @@ def _train(dataset: PGAEDataset, profile, out_dir: str | Path | None, device: to
     ckpt_path = Path(out_dir) / CHECKPOINT if out_dir else None
     if ckpt_path and ckpt_path.exists():
         _resume(run, ckpt_path, profile, normaliser, dataset.source)
+    if not writable and run.epoch < cfg.epochs:
+        raise OutputError(f"cannot train {name} in {out_dir}: the folder cannot be written (a read-only disk, or "
+                          f"no permission), and the model there is not finished ({run.epoch} of the recipe's "
+                          f"{cfg.epochs} epochs trained); train it where it can be written (PGAE_LITE_CACHE)")
     t0 = time.perf_counter() - run.elapsed
     source = None if language is None else language(run.model)    # its encoding time counts as training time
     bar = tqdm(range(run.epoch, cfg.epochs), desc=f"{name} ({profile.name})", initial=run.epoch, total=cfg.epochs,
@@ -186,10 +198,15 @@ def _resume(run: Run, path: Path, profile, normaliser: Normaliser, source: str) 
             f"{path} was trained with a different profile or seed; use another output "
             "folder, or delete the checkpoint to start again")
     check_trained_on(ckpt, normaliser.state_dict(), path, source)
-    run.model.load_state_dict(ckpt["model"])
-    run.optimiser.load_state_dict(ckpt["optimiser"])
-    run.gen.set_state(ckpt["generator"])
-    torch.set_rng_state(ckpt["torch_rng"])
+    load_weights(run.model, ckpt, path)                  # the tensors it expects, each named if missing
+    try:
+        run.optimiser.load_state_dict(ckpt["optimiser"])
+        run.gen.set_state(ckpt["generator"])
+        torch.set_rng_state(ckpt["torch_rng"])
+    except (ValueError, RuntimeError, TypeError, KeyError) as e:     # another optimiser's state, or altered
+        first = (str(e).strip().splitlines() or [type(e).__name__])[0][:120]
+        raise CheckpointMismatchError(f"{path} holds an optimiser or generator state this training cannot resume "
+                                      f"from ({first}); delete the checkpoint to start again") from None
     run.epoch, run.history, run.elapsed = ckpt["epoch"], ckpt["history"], ckpt["seconds"]
 
 

@@ -1,45 +1,58 @@
-"""Shared plumbing: the cache folder, the device, atomic writes, config digests (no paper section).
+"""Shared plumbing: the cache folder, the device, config digests, saved torch files (no paper section).
 
 What several modules need and none of them owns. It imports nothing from
-``pgae_lite``, so any module may import it without a cycle.
+``pgae_lite`` but the other utilities, so any module may import it without a cycle.
 
 - :func:`cache_dir`: the root of every cache (``$PGAE_LITE_CACHE``);
 - :func:`default_device`: CUDA when present, else the CPU;
 - :func:`training_threads`: a training on the CPU runs on a fixed number of torch
   threads, so that a seed gives the same model on any machine;
-- :func:`atomic_path`, :func:`atomic_write`, :func:`atomic_write_text`: a file
-  is written under a temporary name beside its place, then renamed onto it in
-  one step, so a reader (or a crash) never meets half a file;
 - :func:`config_digest`: the short digest of a config that names its cache entry;
   :func:`array_digest`: a digest of arrays' contents (a cache file's check);
-- :func:`save_torch`, :func:`load_torch`: checkpoints written atomically and read
-  with ``weights_only=True``; a write that fails (a full disk, a read-only
-  folder) raises :class:`OutputError`, a damaged or unsafe file
-  :class:`CorruptCheckpointError`, each one sentence naming the file;
-- :func:`folder_lock`: one training run at a time in an output folder (and what dead runs left, removed);
+- :func:`save_torch`, :func:`load_torch`: every saved file (a model, the CAE, a checkpoint, a cache) written
+  atomically and read with ``weights_only=True`` through one set of checks (a folder in the way, a damaged or
+  unsafe file, missing keys, NaN or infinite weights), each failure one sentence naming the file;
+  :func:`load_state`: saved weights into a model, the missing or foreign tensors named;
+  :func:`config_from`: a saved config made a config again, an unknown setting named;
 - :class:`CheckpointMismatchError`: a file holds the work of another recipe.
+
+Atomic writes (:mod:`pgae_lite.util.atomic_files`) and the folder lock (:mod:`pgae_lite.util.folder_lock`)
+live in their own modules; their names are importable from here too.
 """
 from __future__ import annotations
 
 import contextlib
-import errno
+import dataclasses
 import hashlib
 import json
+import math
 import os
 import pickle
-import re
-import shutil
-import socket
-import threading
-import time
-import uuid
 from pathlib import Path
-from typing import IO, Iterator
+from typing import Iterator
 
 import numpy as np
 import torch
 
+from pgae_lite.util.atomic_files import (  # noqa: F401 -- importable from here, as the package always did
+    OutputError,
+    atomic_folder,
+    atomic_path,
+    atomic_write,
+    atomic_write_text,
+    dangling_link,
+    make_folder,
+    why_failed,
+)
 from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.util.folder_lock import (  # noqa: F401 -- importable from here, as the package always did
+    LOCK_BEAT_SECONDS,
+    LOCK_FILE,
+    LOCK_STALE_SECONDS,
+    FolderBusyError,
+    clean_left_behind,
+    folder_lock,
+)
 
 CACHE_ENV = "PGAE_LITE_CACHE"
 
@@ -49,15 +62,11 @@ class CheckpointMismatchError(PGAELiteError, ValueError):
 
 
 class CorruptCheckpointError(PGAELiteError, ValueError):
-    """A checkpoint is empty, truncated, foreign, or holds more than tensors, data."""
+    """A saved file is a folder, empty, truncated, foreign, holds more than tensors and data, or NaN weights."""
 
 
-class OutputError(PGAELiteError, OSError):
-    """A file or folder cannot be written (full disk, read-only, a file in the way)."""
-
-
-class FolderBusyError(PGAELiteError, RuntimeError):
-    """Another live process is training into the same output folder."""
+class SavedFileNotFoundError(PGAELiteError, FileNotFoundError):
+    """No saved file (a checkpoint, a model) where one was named."""
 
 
 def cache_dir() -> Path:
@@ -67,6 +76,11 @@ def cache_dir() -> Path:
     if given is not None and not given.strip():
         raise OutputError(f"{CACHE_ENV} is set but empty; unset it for ~/.cache/pgae_lite, or name a folder")
     folder = Path(given or Path.home() / ".cache" / "pgae_lite").expanduser()
+    link = dangling_link(folder)
+    if link is not None:
+        raise OutputError(f"the cache folder {folder} ({CACHE_ENV}) cannot be used: {link} is a dangling link (to "
+                          f"{os.readlink(link)}, which does not exist); remove the link, make its target, or name "
+                          "another folder")
     if folder.exists() and not folder.is_dir():
         raise OutputError(f"the cache folder {folder} ({CACHE_ENV}) is a file; name a folder")
     return folder
@@ -118,79 +132,6 @@ def array_digest(arrays: dict[str, np.ndarray]) -> str:
     return h.hexdigest()
 
 
-def _why(path: Path, error: BaseException) -> str:
-    """Why a write to ``path`` failed, in words: a full disk said as such."""
-    try:
-        free = shutil.disk_usage(path.parent).free
-    except OSError:
-        free = None
-    full = free is not None and free < 1 << 24                  # under 16 MiB left
-    code = getattr(error, "errno", None)                       # an error without a code may be a full disk
-    if code == errno.ENOSPC or (full and code is None):
-        return f"the disk is full ({free} bytes free)"
-    if isinstance(error, OSError) and error.strerror:
-        return error.strerror
-    text = str(error).strip()
-    return text.splitlines()[0] if text else type(error).__name__
-
-
-def make_folder(folder: str | Path) -> Path:
-    """``mkdir -p`` that fails with one clear sentence (:class:`OutputError`)."""
-    folder = Path(folder)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise OutputError(f"cannot use {folder} as an output folder: a file of that "
-                          "name is in the way") from None
-    except OSError as e:
-        raise OutputError(f"cannot create the output folder {folder}: "
-                          f"{_why(folder, e)}") from None
-    return folder
-
-
-@contextlib.contextmanager
-def atomic_path(path: str | Path) -> Iterator[Path]:
-    """A temporary path beside ``path`` to write to; it replaces ``path`` when the block ends.
-
-    The rename (``os.replace``) is atomic, so ``path`` holds either its old
-    contents or the whole new file, never part of it. A symbolic link at ``path``
-    is refused (:class:`OutputError`): a write never goes through a link. If the block raises, the
-    temporary file is removed and ``path`` is left as it was. The temporary
-    name holds the process id and a random part: parallel writers never share one.
-    """
-    path = Path(path)
-    if path.is_symlink():       # a link planted in a shared folder must not redirect the write
-        raise OutputError(f"refusing to write {path}: it is a symbolic link (to {os.readlink(path)}); "
-                          "remove the link or write to another folder")
-    if path.is_dir():
-        raise OutputError(f"cannot write {path}: it is a folder; name a file")
-    tmp = path.with_name(f"{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    except OutputError:
-        raise
-    except OSError as e:        # full disk, read-only folder, a file for a folder
-        raise OutputError(f"cannot write {path}: {_why(path, e)}; the old file, if "
-                          "any, is unchanged") from None
-    finally:
-        with contextlib.suppress(OSError):
-            tmp.unlink(missing_ok=True)     # only left if the block (or rename) failed
-
-
-@contextlib.contextmanager
-def atomic_write(path: str | Path, mode: str = "wb", **open_kwargs) -> Iterator[IO]:
-    """``open(path, mode)`` for writing, atomically (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp, open(tmp, mode, **open_kwargs) as f:
-        yield f
-
-
-def atomic_write_text(path: str | Path, text: str, encoding: str = "utf-8") -> None:
-    """Write ``text`` to ``path`` atomically (see :func:`atomic_path`)."""
-    with atomic_write(path, "w", encoding=encoding) as f:
-        f.write(text)
-
-
 def save_torch(obj, path: str | Path) -> None:
     """``torch.save(obj, path)``, atomically; :class:`OutputError` if it fails."""
     path = Path(path)
@@ -199,22 +140,40 @@ def save_torch(obj, path: str | Path) -> None:
         try:
             torch.save(obj, tmp)
         except RuntimeError as e:   # torch: "enforce fail at inline_container.cc"
-            raise OutputError(f"cannot write {path}: {_why(path, e)}; the old file, if "
+            raise OutputError(f"cannot write {path}: {why_failed(path, e)}; the old file, if "
                               "any, is unchanged") from None
 
 
-def load_torch(path: str | Path, keys: tuple[str, ...] = (),
-               what: str = "checkpoint") -> dict:
-    """A dict saved by :func:`save_torch`, read with ``weights_only=True``.
+def _not_finite(obj, name: str = "") -> list[str]:
+    """The names (dotted) of the tensors and numbers in ``obj`` (nested dicts, lists) holding NaN or infinity."""
+    if torch.is_tensor(obj):
+        return [name] if obj.is_floating_point() and not bool(torch.isfinite(obj).all()) else []
+    if isinstance(obj, float):
+        return [] if math.isfinite(obj) else [name]
+    if isinstance(obj, dict):
+        return [n for k, v in obj.items() for n in _not_finite(v, f"{name}.{k}" if name else str(k))]
+    if isinstance(obj, (list, tuple)):
+        return [n for i, v in enumerate(obj) for n in _not_finite(v, f"{name}[{i}]")]
+    return []
 
-    Raises :class:`CorruptCheckpointError` naming the file if it is empty,
+
+def load_torch(path: str | Path, keys: tuple[str, ...] = (), what: str = "checkpoint",
+               finite: tuple[str, ...] = ()) -> dict:
+    """A dict saved by :func:`save_torch`, read with ``weights_only=True``: the one reader of every saved file
+    (models, the CAE, checkpoints, caches), and the checks they all get.
+
+    Raises :class:`CorruptCheckpointError` naming the file if it is a folder, empty,
     truncated, not a torch file, holds other Python objects than tensors and
-    plain data (never loaded: unpickling them can run code), or lacks ``keys``.
+    plain data (never loaded: unpickling them can run code), lacks ``keys``, or holds NaN or infinity
+    anywhere under the keys ``finite`` (weights, optimiser state, statistics; the first few named).
+    A missing file is a :class:`SavedFileNotFoundError`.
     """
     path = Path(path)
+    if path.is_dir():
+        raise CorruptCheckpointError(f"{path} is a folder where a {what} (a file) should be; remove or rename "
+                                     "the folder")
     if not path.is_file():
-        folder = " (it is a folder)" if path.is_dir() else ""
-        raise FileNotFoundError(f"no {what} at {path}{folder}")
+        raise SavedFileNotFoundError(f"no {what} at {path}")
     try:
         obj = torch.load(path, map_location="cpu", weights_only=True)
     except pickle.UnpicklingError as e:
@@ -234,116 +193,68 @@ def load_torch(path: str | Path, keys: tuple[str, ...] = (),
     if missing:
         raise CorruptCheckpointError(f"{path} is not a pgae_lite {what}: it lacks "
                                      f"{', '.join(missing)}")
+    broken = [n for k in finite if isinstance(obj, dict) and k in obj for n in _not_finite(obj[k], k)]
+    if broken:
+        weights = "weights" if all(n.startswith("model.") for n in broken) else "values"
+        raise CorruptCheckpointError(f"{path} holds non-finite {weights} (NaN or infinite) in "
+                                     f"{', '.join(broken[:3])}{' ...' if len(broken) > 3 else ''}: the {what} "
+                                     "cannot be used; train it again")
     return obj
 
 
-LOCK_FILE = ".pgae_lite.lock"
-LOCK_BEAT_SECONDS = 60      # a held lock's file is touched this often, so that
-LOCK_STALE_SECONDS = 600    # another machine can tell a dead holder by a file this old
+def _names(names, at_most: int = 3) -> str:
+    names = sorted(names)
+    return ", ".join(names[:at_most]) + (f" and {len(names) - at_most} more" if len(names) > at_most else "")
 
 
-def _dead(pid: int) -> bool:
-    """Whether no process ``pid`` runs on this machine."""
+def load_state(module: torch.nn.Module, state, path: str | Path, what: str = "model") -> torch.nn.Module:
+    """``module`` with the saved weights ``state`` (a state dict read by :func:`load_torch`), or a
+    :class:`CheckpointMismatchError` naming the file and the tensors that are missing, not the module's, or of
+    another shape (another model's weights, another version's, or an altered file)."""
+    if not isinstance(state, dict):
+        raise CorruptCheckpointError(f"{path} holds no weights for the {what} (a {type(state).__name__}, not a "
+                                     "dict of tensors); train it again")
+    expected = module.state_dict()
+    missing, extra = set(expected) - set(state), set(state) - set(expected)
+    shapes = [f"{k} {tuple(state[k].shape)} (the {what}'s: {tuple(v.shape)})" for k, v in expected.items()
+              if k in state and torch.is_tensor(v) and torch.is_tensor(state[k]) and state[k].shape != v.shape]
+    problems = ([f"it lacks the tensor(s) {_names(missing)}"] if missing else []) + \
+               ([f"it holds tensor(s) the {what} has not: {_names(extra)}"] if extra else []) + \
+               ([f"tensor(s) of another shape: {_names(shapes, 2)}"] if shapes else [])
+    if not problems:
+        try:
+            module.load_state_dict(state)
+            return module
+        except (RuntimeError, TypeError, AttributeError, ValueError) as e:
+            problems = [(str(e).strip().splitlines() or [type(e).__name__])[-1].strip()[:160]]
+    raise CheckpointMismatchError(f"{path} holds weights that do not fit the {what} its recipe describes "
+                                  f"({'; '.join(problems)}): it was written by another version of the package "
+                                  "or altered; train the model again")
+
+
+def config_from(cls, settings, path: str | Path, what: str):
+    """``cls(**settings)``: a saved config (a dataclass's dict) made a config again, or a
+    :class:`CheckpointMismatchError` naming the file and the setting that this version does not know or refuses
+    (an older or newer pgae_lite's file, or an altered one)."""
+    if not isinstance(settings, dict):
+        raise CheckpointMismatchError(f"{path} holds no {what} (a {type(settings).__name__}, not a dict of "
+                                      "settings): it is not a pgae_lite file, or it was altered")
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = [k for k in settings if k not in known]
+    if unknown:
+        raise CheckpointMismatchError(f"{path} holds {what} this pgae_lite does not know ({_names(map(str, unknown))}"
+                                      f"; it knows {_names(known, 40)}): it was written by another version of the "
+                                      "package or altered; train the model again")
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except PermissionError:
-        pass                          # alive, another user's
-    return False
+        return cls(**settings)
+    except (TypeError, ValueError) as e:       # a value of the wrong type or out of range: said in one sentence
+        first = (str(e).strip().splitlines() or [type(e).__name__])[0]
+        raise CheckpointMismatchError(f"{path} holds {what} this pgae_lite refuses ({first}); it was written by "
+                                      "another version of the package or altered; train the model again") from None
 
 
-def _holder(lock: Path) -> str | None:
-    """``host:pid`` of a lock's live holder; None if the lock is stale (or gone)."""
-    try:
-        host, _, pid = lock.read_text().strip().rpartition(":")
-    except OSError:
-        return None
-    if host != socket.gethostname():  # another machine's process: alive while it touches its lock
-        with contextlib.suppress(OSError):
-            if time.time() - lock.stat().st_mtime > LOCK_STALE_SECONDS:
-                return None
-        return f"{host}:{pid}"
-    if not pid.isdigit() or int(pid) == os.getpid():
-        return None                   # unreadable, or left by this very process
-    return None if _dead(int(pid)) else f"{host}:{pid}"
-
-
-# What a run leaves when it is killed: its lock's link source, a taken-over lock, half-written files.
-_LEFT_BEHIND = re.compile(rf"(?:{re.escape(LOCK_FILE)}|.+)\.(\d+)-[0-9a-f]{{8}}(?:\.tmp|\.stale)?")
-
-
-def clean_left_behind(folder: Path) -> list[Path]:
-    """Remove the lock and temporary files that dead processes left in ``folder`` (and below); the removed."""
-    removed = []
-    for path in folder.rglob("*"):
-        hit = _LEFT_BEHIND.fullmatch(path.name)
-        if hit and path.is_file() and not path.is_symlink() and int(hit.group(1)) != os.getpid() \
-                and _dead(int(hit.group(1))):
-            with contextlib.suppress(OSError):
-                path.unlink()
-                removed.append(path)
-    return removed
-
-
-def _beat(lock: Path, stop: threading.Event) -> None:
-    """Touch ``lock`` every ``LOCK_BEAT_SECONDS`` until ``stop``: its holder is alive."""
-    while not stop.wait(LOCK_BEAT_SECONDS):
-        with contextlib.suppress(OSError):
-            os.utime(lock)
-
-
-@contextlib.contextmanager
-def folder_lock(folder: str | Path) -> Iterator[None]:
-    """Hold ``folder``'s lock file while the block runs: a second run there fails.
-
-    The lock file holds ``host:pid``; a lock whose process has died is taken over (on another
-    machine, one not touched for ``LOCK_STALE_SECONDS``: its holder touches it every
-    ``LOCK_BEAT_SECONDS``), and the lock and temporary files that dead runs left in the
-    folder are removed (:func:`clean_left_behind`).
-    """
-    lock = make_folder(folder) / LOCK_FILE
-    token = f"{socket.gethostname()}:{os.getpid()}"
-    mine = lock.with_name(f"{LOCK_FILE}.{os.getpid()}-{uuid.uuid4().hex[:8]}")
-    try:
-        mine.write_text(token)
-        while True:
-            try:
-                os.link(mine, lock)              # atomic: fails if a lock is there
-                break
-            except FileExistsError:
-                holder = _holder(lock)
-                if holder is not None:
-                    raise FolderBusyError(
-                        f"{folder} is in use by another run (process {holder}, lock "
-                        f"file {lock}); wait for it, use another folder, or delete the "
-                        "lock file if that process is gone") from None
-                stale = lock.with_name(f"{mine.name}.stale")
-                with contextlib.suppress(FileNotFoundError):
-                    os.replace(lock, stale)      # one taker wins; the others retry
-                    stale.unlink()
-    except OSError as e:
-        mine.unlink(missing_ok=True)
-        raise OutputError(f"cannot write the lock file {lock}: "
-                          f"{_why(lock, e)}") from None
-    except BaseException:
-        mine.unlink(missing_ok=True)
-        raise
-    clean_left_behind(lock.parent)
-    stop = threading.Event()
-    threading.Thread(target=_beat, args=(lock, stop), daemon=True).start()
-    try:
-        yield
-    finally:
-        stop.set()
-        with contextlib.suppress(OSError):
-            if lock.read_text() == token:
-                lock.unlink()
-        mine.unlink(missing_ok=True)
-
-
-__all__ = ["CACHE_ENV", "CheckpointMismatchError", "CorruptCheckpointError",
-           "FolderBusyError", "OutputError", "array_digest", "atomic_path",
-           "atomic_write", "atomic_write_text", "cache_dir", "clean_left_behind", "config_digest",
-           "default_device", "folder_lock", "load_torch", "make_folder", "save_torch",
-           "training_threads", "TRAINING_THREADS"]
+# The names of pgae_lite.util.atomic_files and pgae_lite.util.folder_lock imported above stay importable from
+# here (the package's modules and tests always imported them so); they are documented where they live.
+__all__ = ["CACHE_ENV", "CheckpointMismatchError", "CorruptCheckpointError", "SavedFileNotFoundError",
+           "TRAINING_THREADS", "array_digest", "cache_dir", "config_digest", "config_from", "default_device",
+           "load_state", "load_torch", "save_torch", "training_threads"]

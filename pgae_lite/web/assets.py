@@ -50,6 +50,7 @@ from pgae_lite.web.messages import page_messages
 from pgae_lite.web.parity import write_parity
 from pgae_lite.web.sim_runs import chosen_episodes, simulator_runs
 from pgae_lite.world.colours import CUBE_RGBA
+from pgae_lite.world.typed import typed_rules
 from pgae_lite.world.words import DEFAULT_LEXICON, SIGNALS, SLOT_NAMES, SLOTS, SYNONYMS, VOCABULARY
 
 #: The models the playground offers, by the name the page shows, and their trainings.
@@ -135,7 +136,7 @@ def export_web(out: str | Path, profile: Profile, seed: int = 0, progress: bool 
         "sees_action": [bool(x) for x in ACTION_IN], "lang_out": [bool(x) for x in LANG_OUT],
         "describe": SIGNALS.index("describe"), "repeat_language": SIGNALS.index("repeat language"),
         "signal_token": SIGNAL_TOKEN, "eos": EOS, "vision_dim": VISION_DIM, "joint_dim": JOINT_DIM,
-        "messages": page_messages(), "play": play_choices(data, prof.data),
+        "messages": page_messages(), "play": play_choices(data, prof.data), "typed": typed_rules(),
         "models": models, "episodes": episodes, "episodes_files": files, "joint_units": list(normaliser.joints),
         "fixed_rows": {",".join(map(str, row)): r for r, row in enumerate(rows.tolist())},
         "fixed_texts": {tokens_to_text(row): r for r, row in enumerate(rows)}, "free_text": free_text,

@@ -8,15 +8,21 @@ no part of this data: each sentence is a template of ``refusals.MESSAGES``, whic
 its manifest (:mod:`pgae_lite.web.messages`) and fills as Python formats it::
 
     refusals.json        shared by the models:
-      negators, sequencers, clause_end, step_end   the rule's closed classes of words and its patterns
-      colours, actions_said                        the world's six colours (the first: a negation's example);
+      negators, sequencers, ..., most_characters    the rule's closed classes of words
+                                                   (refusal_words.closed_classes)
+      clause_end, step_end                         its patterns
+      colours, speeds, actions_said                the world's six colours (the first: a negation's example),
+                                                   its two speeds;
                                                    what the robot can do (the field ``actions`` of two messages)
       colour_words       WordNet's words with a sense that is a kind of colour (refusals.is_colour_word)
       verbs              WordNet's words with a verb sense, front-coded (:func:`front_coded`)
     models/NAME.refusals.json   one model's reading:
       phrases            the phrase table slot_meanings reads, [words, slot, meaning] (None: skipped)
       phrases_by_verbs   the same with the directions left out (actions counted by their verbs)
+      directions         each direction phrase of its lexicon -> its action (refusal_words.direction_table)
       known              the words of ``colour_words`` and ``verbs`` its lookup knows (is_known)
+      untrusted          the words of its word table read as an action that is no word of the world's
+                         actions (refusals.looked_up_action: ``lift`` -> ``haul``)
 
 The words are decided over the same candidates as the word table (:mod:`pgae_lite.web.word_table`):
 each lemma of WordNet and each form one ending away; a word outside them has no sense, so Python
@@ -28,9 +34,10 @@ from dataclasses import replace
 
 from pgae_lite.freeform import refusals
 from pgae_lite.freeform.phrasings import phrase_table
+from pgae_lite.freeform.refusal_words import closed_classes, direction_table
 from pgae_lite.freeform.word_lookup import WordLookup, wordnet
-from pgae_lite.web.word_table import candidates
-from pgae_lite.world.words import COLOURS
+from pgae_lite.web.word_table import candidates, word_table
+from pgae_lite.world.words import COLOURS, SPEEDS
 
 
 def front_coded(words: list[str]) -> str:
@@ -46,14 +53,14 @@ def front_coded(words: list[str]) -> str:
     return "\n".join(lines)
 
 
-def shared_words() -> dict:
+def shared_words(words=None) -> dict:
     """What every model's refusal reads: the rule's words and patterns, WordNet's colour words and verbs
-    (a sorted list here; :func:`front_coded` when written)."""
+    (a sorted list here; :func:`front_coded` when written), decided over ``words`` (default: the word
+    table's candidates, :func:`~pgae_lite.web.word_table.candidates`)."""
     dictionary = wordnet()
-    words = candidates(shortest=1)                                    # a verb may be short: "go"
-    return {"negators": sorted(refusals.NEGATORS), "sequencers": sorted(refusals.SEQUENCERS),
-            "clause_end": refusals._CLAUSE_END.pattern, "step_end": refusals._STEP_END.pattern,
-            "colours": list(COLOURS), "actions_said": refusals.ACTIONS_SAID,
+    words = candidates(shortest=1) if words is None else sorted(set(words))   # a verb may be short: "go"
+    return {**closed_classes(), "clause_end": refusals._CLAUSE_END.pattern, "step_end": refusals._STEP_END.pattern,
+            "colours": list(COLOURS), "speeds": list(SPEEDS), "actions_said": refusals.ACTIONS_SAID,
             "colour_words": [w for w in words if len(w) >= 3 and refusals.is_colour_word(w)],
             "verbs": [w for w in words if dictionary.synsets(w, pos="v")]}
 
@@ -62,13 +69,19 @@ def _table(lexicon) -> list:
     return [[" ".join(words), *(hit or (None, None))] for words, hit in phrase_table(lexicon).items()]
 
 
-def model_reading(encoder, shared: dict) -> dict:
-    """One model's phrase tables and the words of ``shared`` its lookup knows."""
+def model_reading(encoder, shared: dict, table: dict[str, str] | None = None) -> dict:
+    """One model's phrase tables, its directions, the words of ``shared`` its lookup knows and the words of
+    its word ``table`` (default: :func:`~pgae_lite.web.word_table.word_table` of its own lookup) read as an
+    action the world has no word for."""
     lookup: WordLookup = refusals.lookup_of(encoder)
     lexicon = lookup.lexicon
     by_verbs = replace(lexicon, directions={a: () for a in lexicon.directions})
+    if table is None:
+        table = {} if encoder.word_lookup is None else word_table(encoder.word_lookup)
     return {"phrases": _table(lexicon), "phrases_by_verbs": _table(by_verbs),
-            "known": sorted(w for w in (*shared["verbs"], *shared["colour_words"]) if lookup.is_known(w))}
+            "directions": direction_table(lexicon),
+            "known": sorted(w for w in (*shared["verbs"], *shared["colour_words"]) if lookup.is_known(w)),
+            "untrusted": sorted(w for w, read in table.items() if refusals.looked_up_action(w, read, lexicon))}
 
 
 __all__ = ["front_coded", "model_reading", "shared_words"]

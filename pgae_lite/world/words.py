@@ -27,6 +27,7 @@ from functools import cached_property
 import torch
 
 from pgae_lite.util.errors import PGAELiteError
+from pgae_lite.world.typed import normalise_typed
 
 BOS_EOS = "<BOS/EOS>"
 
@@ -187,7 +188,8 @@ def signal_index(signal: str) -> int:
 def tokenize(text: str, lexicon: Lexicon | None = None) -> list[str]:
     """Split user text into vocabulary words, leniently.
 
-    Case, punctuation and extra spaces are ignored and two-word synonyms may be
+    The text is read as :func:`~pgae_lite.world.typed.normalise_typed` gives it; case, punctuation and
+    extra spaces are ignored and two-word synonyms may be
     written with a space (``move up``, ``greenish blue``). Unknown words raise
     :class:`LanguageError` naming every one of them and listing the vocabulary.
     """
@@ -195,7 +197,7 @@ def tokenize(text: str, lexicon: Lexicon | None = None) -> list[str]:
         raise LanguageError(f"the text must be a string, e.g. 'push red slowly'; got "
                             f"{type(text).__name__} {text!r:.80}")
     lex = lexicon or DEFAULT_LEXICON
-    words = re.sub(r"[.,;:!?]", " ", str(text).lower().replace(BOS_EOS.lower(), " ")).split()
+    words = re.sub(r"[.,;:!?]", " ", normalise_typed(text).lower().replace(BOS_EOS.lower(), " ")).split()
     tokens: list[str] = []
     unknown: list[str] = []
     i = 0
@@ -215,8 +217,7 @@ def tokenize(text: str, lexicon: Lexicon | None = None) -> list[str]:
     return tokens
 
 
-def parse_description(text: str, lexicon: Lexicon | None = None
-                      ) -> tuple[str, str, str]:
+def parse_description(text: str, lexicon: Lexicon | None = None) -> tuple[str, str, str]:
     """Parse ``action colour speed`` into canonical words, e.g. ``('push', 'red', 'fast')``.
 
     Raises :class:`LanguageError` for unknown words, a wrong length or a word in
@@ -238,8 +239,7 @@ def parse_description(text: str, lexicon: Lexicon | None = None
 
 
 def equivalent_descriptions(action: str, colour: str, speed: str,
-                            lexicon: Lexicon | None = None
-                            ) -> list[tuple[str, str, str]]:
+                            lexicon: Lexicon | None = None) -> list[tuple[str, str, str]]:
     """The 8 equivalent descriptions of one meaning (each word or its synonym).
 
     Order follows the authors' data: canonical first, the action word's
@@ -251,8 +251,7 @@ def equivalent_descriptions(action: str, colour: str, speed: str,
     return [tuple(reversed(c)) for c in itertools.product(*choices)]
 
 
-def encode(words: tuple[str, ...] | list[str],
-           lexicon: Lexicon | None = None) -> torch.Tensor:
+def encode(words: tuple[str, ...] | list[str], lexicon: Lexicon | None = None) -> torch.Tensor:
     """Word list -> index tensor with ``<BOS/EOS>`` at both ends, shape (len + 2,).
 
     The words are vocabulary words as written (``move-up``, not ``move up``); a string,
@@ -272,8 +271,12 @@ def encode(words: tuple[str, ...] | list[str],
 
 
 def one_hot(indices: torch.Tensor, dim: int = len(VOCABULARY)) -> torch.Tensor:
-    """Indices (...,) -> one-hot float vectors (..., dim)."""
-    return torch.nn.functional.one_hot(indices.long(), dim).float()
+    """Indices (...,) -> one-hot float vectors (..., dim); an index outside 0 to dim-1 is a LanguageError."""
+    t = torch.as_tensor(indices)
+    if t.is_floating_point() or t.is_complex() or t.dtype == torch.bool or bool(((t < 0) | (t >= dim)).any()):
+        raise LanguageError(f"one_hot takes word indices, whole numbers 0-{dim - 1} (the vocabulary's {dim} words); "
+                            f"got {t.dtype} values {t.flatten()[:8].tolist()}")
+    return torch.nn.functional.one_hot(t.long(), dim).float()
 
 
 def decode(indices: torch.Tensor | list[int], lexicon: Lexicon | None = None) -> str:
