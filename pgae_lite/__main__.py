@@ -32,10 +32,6 @@ PROFILE_ENV = "PGAE_LITE_PROFILE"
 PROFILE_NAMES = ("smoke", "book", "paper")
 ROW_NAMES = ("PGAE", "PGAE-BERT", "PGAE-self", "PGAE-opposite")
 FAMILY_ROW_NAMES = ("PRAE", "PVAE", "PVAE-BERT", "PVAE-BERT-tuned", "PTAE")
-#: What ``reproduce`` writes into its output folder (pgae_lite.runs.reproduce's layout): a folder holding
-#: only these (a run to resume), or its results.json (a finished run), is one it wrote; any other non-empty
-#: folder is refused.
-REPRODUCE_WRITES = ("results.json", "predictions.npz", "*-seed*", "logs")
 #: The file ``export-web`` writes last into its folder: a folder holding it is one it wrote.
 EXPORT_MARKER = "manifest.json"
 
@@ -194,10 +190,11 @@ def run_command(args: argparse.Namespace) -> int:
         return simulate(profile, args.workers, not args.no_progress)
     if args.command == "export-web":
         return export_web(args, profile)
-    if args.out is not None:
-        output_folder("--out", args.out, "reproduce", written=REPRODUCE_WRITES, marker="results.json",
+    from pgae_lite.runs.reproduce import WRITES, check_arguments, reproduce
+
+    if args.out is not None:   # a folder holding only what reproduce writes (a run to resume), or its results.json
+        output_folder("--out", args.out, "reproduce", written=WRITES, marker="results.json",
                       default="runs/DATA-PROFILE-seedSEED")
-    from pgae_lite.runs.reproduce import check_arguments, reproduce
 
     original = args.original_data
     if original is None and ORIGINAL_DATA_ENV in os.environ:

@@ -112,7 +112,7 @@ def test_reproduce_resumes_in_a_folder_it_wrote(tmp_path):
         (out / name).mkdir(parents=True)
     (out / "results.json").write_text("{}")
     (out / ".pgae_lite.lock.123-0123abcd").write_text("")
-    from pgae_lite.__main__ import REPRODUCE_WRITES
+    from pgae_lite.runs.reproduce import WRITES as REPRODUCE_WRITES
 
     assert output_folder("--out", out, "reproduce", written=REPRODUCE_WRITES) == out.resolve()
 

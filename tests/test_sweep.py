@@ -80,19 +80,41 @@ def slowly_negated(x: int) -> int:
 @pytest.mark.timeout(120)
 def test_two_sweeps_on_one_cluster_at_once_each_get_their_own_results(dask_cluster):
     """Two sweeps (two users of a lab's cluster, two chapters) on one scheduler at the same time, under the same
-    sweep name: each gets the results of its own units."""
+    sweep name: each gets the results of its own units, and each its results at all (one process's two clients:
+    a sweep that waited on the other's event loop never heard of its results once the other had closed)."""
     import threading
 
     results = {}
 
     def sweep(work):
         results[work.__name__] = run_sweep(work, [(1,), (2,)], scheduler=dask_cluster.address, progress=False)
-    threads = [threading.Thread(target=sweep, args=(work,)) for work in (slowly, slowly_negated)]
+    threads = [threading.Thread(target=sweep, args=(work,), daemon=True) for work in (slowly, slowly_negated)]
     for thread in threads:
         thread.start()
     for thread in threads:
         thread.join(timeout=100)
     assert results == {"slowly": [1, 2], "slowly_negated": [-1, -2]}
+
+
+@pytest.mark.timeout(120)
+def test_a_sweep_hears_its_results_when_another_client_of_its_process_closes(dask_cluster):
+    """A sweep's client, then another (this process's latest, Dask's default) closed while the sweep runs: the
+    sweep waits on its own client's event loop, not on the default's, and gets its results (it hung before)."""
+    import threading
+
+    from distributed import Client
+
+    for _ in range(3):
+        results = []
+        mine, other = Client(dask_cluster.address), Client(dask_cluster.address)
+        thread = threading.Thread(target=lambda: results.append(
+            run_sweep(slowly, [(1,), (2,), (3,)], client=mine, progress=False)), daemon=True)   # noqa: B023
+        thread.start()
+        time.sleep(0.3)
+        other.close()
+        thread.join(timeout=30)
+        mine.close()
+        assert results == [[1, 2, 3]], "the sweep never heard of its results"
 
 
 def resumable_unit(seed: int, folder: str, pause: float = 1.0) -> dict:

@@ -36,7 +36,8 @@ from pgae_lite.data.dataset import PGAEDataset
 from pgae_lite.evaluate.table1 import Predictions, format_table
 from pgae_lite.runs.data import data_source, loaded, remember
 from pgae_lite.runs.rows import ROWS, TABLE1_ROWS
-from pgae_lite.runs.sweep import SCHEDULER_ENV, run_sweep
+from pgae_lite.runs.scheduler import connect, disconnect, scheduler_address
+from pgae_lite.runs.sweep import run_sweep
 from pgae_lite.runs.table1_unit import check_made_on, table1_unit
 from pgae_lite.util.checks import MAX_SEED, instance_of, torch_device, whole_number
 from pgae_lite.util.errors import ArgumentError
@@ -44,6 +45,8 @@ from pgae_lite.util.storage import atomic_write, atomic_write_text, default_devi
 from pgae_lite.world.words import TEST_SIGNALS
 
 CELLS = ("accuracy", "nrmse", "nrmse_padded")
+#: What :func:`reproduce` writes into its folder (the layout above): a folder holding only these is one it wrote.
+WRITES = ("results.json", "predictions.npz", "*-seed*", "logs")
 MAX_SEEDS = 100                                     # models per row: a sane count
 #: The command line's name of each argument :func:`check_arguments` checks.
 FLAGS = {"original_data": "--original-data", "rows": "--rows", "seed": "--seed",
@@ -93,11 +96,7 @@ def check_arguments(original_data, rows, seed, seeds, epochs, device, pretrained
         whole_number(name["epochs"], epochs, 1)
     if workers is not None:
         whole_number(name["workers"], workers, 1)
-    instance_of(name["scheduler"], scheduler, str, "a Dask scheduler's address, e.g. tcp://host:8786",
-                optional=True)
-    if scheduler is not None and not scheduler.strip():
-        raise ArgumentError(f"{name['scheduler']} is empty (an unset variable?); give a Dask scheduler's "
-                            f"address, e.g. tcp://host:8786, or leave {name['scheduler']} out to run here")
+    scheduler_address(scheduler, name["scheduler"])     # or $PGAE_DASK_SCHEDULER: a Dask scheduler's address
     torch_device(name["device"], device)
     defaults = {"original_data": "our simulated data",
                 "out_dir": "runs/DATA-PROFILE-seedSEED"}
@@ -165,16 +164,18 @@ def summarise(per_seed: list[dict[str, dict[str, float | None]]]) -> tuple[dict,
 def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Path,
                profile: Profile, device: str | None = None, progress: bool = True,
                pretrained_model: str | None = None, original_data: str | Path | None = None,
-               workers: int | None = None, scheduler: str | None = None) -> dict:
+               workers: int | None = None, scheduler: str | None = None, client=None) -> dict:
     """Train (or resume) every training the ``rows`` need, for every seed; evaluate; write ``out``.
 
     Each (training, seed) is one unit (:func:`~pgae_lite.runs.table1_unit.table1_unit`). On the CPU
     with more than one unit they run as a sweep (:func:`~pgae_lite.runs.sweep.run_sweep`): ``workers``
     single-threaded processes here (default: one per core, at most one per unit), or the Dask
     cluster at ``scheduler`` (or ``$PGAE_DASK_SCHEDULER``), whose workers read ``original_data``
-    at the same path, or make this profile's simulated data in their own cache. Else, or with
-    ``workers=1``, one after another in this process. Every unit's model is checked against
-    ``dataset`` (:func:`~pgae_lite.runs.table1_unit.check_made_on`).
+    at the same path, or make this profile's simulated data in their own cache; ``client``: a client
+    already connected to it (:func:`~pgae_lite.runs.scheduler.connect`). Else, or with ``workers=1``,
+    one after another in this process. Every unit's model is checked against ``dataset``
+    (:func:`~pgae_lite.runs.table1_unit.check_made_on`). A scheduler lost in the middle of the sweep
+    is one sentence that names what is saved in ``out`` and how to resume.
     """
     dataset.split("train"), dataset.split("test")    # both needed: refused now, not after the trainings
     make_folder(out)                 # a file in the way, or no permission: one sentence
@@ -182,9 +183,15 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
     trainings = list({ROWS[r].training.name: ROWS[r].training for r in rows}.values())
     units = [(source, profile, t, seed, [ROWS[r] for r in rows if ROWS[r].training == t], str(Path(out).resolve()),
               device, pretrained_model) for t in trainings for seed in seeds]
-    if _as_sweep(len(units), device, workers, scheduler):
+    if client is not None or _as_sweep(len(units), device, workers, scheduler):
+        folders = [f"{t.name}-seed{seed}" for t in trainings for seed in seeds]
+        shown = ", ".join(folders[:3]) + (f" and {len(folders) - 3} more" if len(folders) > 3 else "")
+        saved = (f"each training finished or checkpointed so far is saved in {out} ({shown}: checkpoint.pt); run "
+                 f"the same command again with the same output folder, on the scheduler restarted or here without "
+                 f"one, to resume from them")
         done = run_sweep(table1_unit, units, workers=min(workers or os.cpu_count() or 1, len(units)),
-                         scheduler=scheduler, logs=Path(out) / "logs", name="table1", progress=progress)
+                         scheduler=scheduler, logs=Path(out) / "logs", name="table1", progress=progress,
+                         client=client, on_lost=saved)
     else:
         remember(data_source(original_data, profile), dataset)
         done = [table1_unit(*unit, progress=progress) for unit in units]
@@ -213,7 +220,7 @@ def run_table1(dataset: PGAEDataset, rows: list[str], seeds: list[int], out: Pat
 def _as_sweep(units: int, device: str | None, workers: int | None, scheduler: str | None) -> bool:
     """Whether :func:`run_table1` runs its units as a sweep: on a given cluster always; here, on the
     CPU with more than one unit and more than one worker (a GPU trains one model at a time)."""
-    if scheduler or os.environ.get(SCHEDULER_ENV):
+    if scheduler_address(scheduler) is not None:
         return True
     import torch
 
@@ -233,18 +240,25 @@ def reproduce(original_data: str | Path | None = None, profile: str | None = Non
     :data:`pgae_lite.runs.rows.ROWS` (default ``["PGAE"]``, ``"all"`` for every row). ``seeds`` models
     per row are trained, with seeds ``seed, seed + 1, ...``: on the CPU, side by side on ``workers``
     cores (default: all), or on the Dask cluster at ``scheduler`` (:func:`run_table1`). Every
-    argument is checked before any data is read (:func:`check_arguments`).
+    argument is checked before any data is read (:func:`check_arguments`), and so is the cluster: the
+    scheduler answers and a worker has joined (:func:`~pgae_lite.runs.scheduler.connect`).
     """
     rows = check_arguments(original_data, rows, seed, seeds, epochs, device,
                            pretrained_model, out_dir, workers, scheduler)
     prof = get_profile(profile, **({} if epochs is None else {"epochs": epochs}))
-    source = data_source(original_data, prof)        # the authors' folder, or this profile's simulated data
-    dataset = loaded(source, device, progress)
-    default_out = f"runs/{source.kind}-{prof.name}-seed{seed}"
-    out = Path(out_dir if out_dir is not None else default_out)
-    t0 = time.perf_counter()
-    report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,
-                        pretrained_model, original_data, workers, scheduler)
+    named = scheduler_address(scheduler)             # the argument, else $PGAE_DASK_SCHEDULER, else None: here
+    client = None if named is None else connect(named)      # nobody there, no worker: one sentence, no data read
+    try:
+        source = data_source(original_data, prof)    # the authors' folder, or this profile's simulated data
+        dataset = loaded(source, device, progress)
+        default_out = f"runs/{source.kind}-{prof.name}-seed{seed}"
+        out = Path(out_dir if out_dir is not None else default_out)
+        t0 = time.perf_counter()
+        report = run_table1(dataset, rows, list(range(seed, seed + seeds)), out, prof, device, progress,
+                            pretrained_model, original_data, workers, scheduler, client)
+    finally:
+        if client is not None:
+            disconnect(client)
     report |= {"data": dataset.source if original_data is None else str(original_data),
                "wall_seconds": time.perf_counter() - t0}
     nonfinite = write_results(out / "results.json", report)

@@ -10,7 +10,17 @@ cluster and returns the results in the units' order:
   (``workers`` to choose how many);
 - with ``scheduler="tcp://host:8786"`` (or ``$PGAE_DASK_SCHEDULER``) an existing cluster: started
   by hand (``dask scheduler``, then ``dask worker tcp://host:8786 --nthreads 1`` on each
-  machine), over SSH (``distributed.SSHCluster``) or on SLURM/PBS (``dask-jobqueue``).
+  machine), over SSH (``distributed.SSHCluster``) or on SLURM/PBS (``dask-jobqueue``). Its address
+  is checked, and the scheduler reached with a worker joined, before any unit is sent
+  (:mod:`pgae_lite.runs.scheduler`: each failure one sentence).
+
+Sweeps share a cluster without sharing results: every task's key holds a token drawn for its
+sweep, so a task stands for "unit K of this sweep", whose arguments (recipe, data, seed,
+training, output folder) are its sweep's own. Two sweeps, at once or one after the other, with
+the same recipe or not, never receive each other's results; identical work is shared on purpose
+on disk instead (a unit's training folder: a second run with the same recipe loads, or waits for,
+the first run's model). A scheduler lost in the middle of a sweep is one sentence that says what
+was saved and how to resume (``on_lost``).
 
 A worker that dies in the middle of a unit loses that unit's unsaved epochs only: the scheduler
 gives the task to another worker (up to ``allowed_failures`` times) and the unit resumes from
@@ -24,9 +34,18 @@ import os
 import sys
 import time
 import uuid
+from concurrent.futures import CancelledError
 from pathlib import Path
 
-SCHEDULER_ENV = "PGAE_DASK_SCHEDULER"
+from pgae_lite.runs.scheduler import (
+    SCHEDULER_ENV,
+    SchedulerError,
+    connect,
+    disconnect,
+    is_lost,
+    lost,
+    scheduler_address,
+)
 
 
 def _logged(work, log: str | None, *args):
@@ -39,14 +58,15 @@ def _logged(work, log: str | None, *args):
 
 
 def client_for(scheduler: str | None = None, workers: int | None = None):
-    """A Dask client: on the cluster at ``scheduler`` (else ``$PGAE_DASK_SCHEDULER``), or on a new
-    ``LocalCluster`` of ``workers`` single-threaded processes (default: one per core)."""
+    """A Dask client: on the cluster at ``scheduler`` (else ``$PGAE_DASK_SCHEDULER``), checked and with a worker
+    joined (:func:`~pgae_lite.runs.scheduler.connect`), or on a new ``LocalCluster`` of ``workers``
+    single-threaded processes (default: one per core)."""
     import dask
     from distributed import Client, LocalCluster
 
-    address = scheduler or os.environ.get(SCHEDULER_ENV) or None
-    if address:
-        return Client(address)
+    named = scheduler_address(scheduler)
+    if named is not None:
+        return connect(named)
     n = workers or os.cpu_count() or 1
     if not isinstance(n, int) or n < 1:
         raise ValueError(f"workers must be a whole number >= 1; got {workers!r}")
@@ -72,19 +92,26 @@ def _progress(done: int, running: int, total: int, elapsed: float) -> str:
 
 
 def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler: str | None = None,
-              logs: str | Path | None = None, name: str = "sweep", progress: bool = True) -> list:
+              logs: str | Path | None = None, name: str = "sweep", progress: bool = True, client=None,
+              on_lost: str = "what each unit saved is kept: run the sweep again to resume from it") -> list:
     """``[work(*unit) for unit in units]``, each unit a task on a Dask cluster (see the module).
 
     ``work`` must be importable or picklable by the workers (a module-level function) and should
     set its own threads (one: these networks gain nothing from two). ``logs``: a folder for one
     log file per unit (``NAME-K.log``). A unit that raises makes the sweep raise, naming it and
-    its error. ``progress``: print the dashboard's address and the progress line.
+    its error. ``progress``: print the dashboard's address and the progress line. ``client``: a
+    client already connected (:func:`client_for`), which the caller closes; else one is made and
+    closed here. A scheduler lost during the sweep raises a
+    :class:`~pgae_lite.runs.scheduler.SchedulerError` that ends with ``on_lost`` (what was saved,
+    how to resume).
     """
     from distributed import as_completed
 
     if not units:
         return []
-    client = client_for(scheduler, workers)
+    own = client is None
+    client = client_for(scheduler, workers) if own else client
+    address, done = client.scheduler.address, 0
     try:
         from pgae_lite.runs.sweep_worker import OneCoreWorker
 
@@ -98,8 +125,10 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
                    for k, unit in enumerate(units)]
         index = {f.key: k for k, f in enumerate(futures)}
         results: list = [None] * len(units)
-        started, done = time.perf_counter(), 0
-        for future in as_completed(futures):
+        started = time.perf_counter()
+        # This client's own event loop: Dask's default is the process's latest client's, which another sweep
+        # of this process may close before this one ends (its results then never arrive).
+        for future in as_completed(futures, loop=client.loop):
             k = index[future.key]
             if future.status == "error":
                 error = future.exception()
@@ -112,11 +141,16 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
                 print(_progress(done, running, len(units), time.perf_counter() - started), file=sys.stderr,
                       flush=True)
         return results
+    except (CancelledError, OSError) as e:          # Dask's: a task cancelled, a connection closed
+        if not is_lost(client, e) and not isinstance(e, CancelledError):
+            raise
+        when = f"in the middle of the sweep {name!r}, with {done} of {len(units)} units done"
+        if not is_lost(client, e):
+            when = f"or restarted (a unit was cancelled there) {when}"
+        raise SchedulerError(lost(address, when, on_lost)) from e
     finally:
-        cluster = getattr(client, "cluster", None)
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        if own:
+            disconnect(client)
 
 
 __all__ = ["SCHEDULER_ENV", "client_for", "run_sweep"]
