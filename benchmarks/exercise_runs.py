@@ -10,8 +10,9 @@ An exercise's trainings run on the seeds of :data:`EXERCISES` (0 alone where one
 over 3 minutes on one core, else 0, 1 and 2), or on ``--seeds``. The figures merge into
 results/exercise_runs.json, one entry per exercise label, each with its own command, commit, date
 and seconds, so that exercises can be run one at a time; the solutions quote them from there. The
-exercises whose runs are beyond this benchmark's budget (about 40 minutes on one core for all of them)
-are named, with the reason, in tests/test_exercise_solutions.py (``AWAITING_A_RESULT``).
+exercises of chapters 06 and 07 and appendices A3 and A4 are in benchmarks/exercise_runs_acting.py
+(its ``EXERCISES`` merge into this one's). The exercises whose runs this benchmark cannot make are
+named, with the reason, in tests/test_exercise_solutions.py (``AWAITING_A_RESULT``).
 """
 from __future__ import annotations
 
@@ -28,6 +29,8 @@ from pathlib import Path
 
 import numpy as np
 import torch
+from exercise_runs_acting import EXERCISES as ACTING
+from exercise_runs_acting import cells
 from harness import ROOT, Benchmark
 from torch import nn
 from torch.nn import functional as F
@@ -36,7 +39,6 @@ import pgae_lite.model.pvae as pvae_module
 from pgae_lite.bert.pretrained import PretrainedLanguageEncoder
 from pgae_lite.cae import ChannelAutoencoder, ChannelSeparatedCAE, as_input, extract_features, train_cae
 from pgae_lite.config import get_profile
-from pgae_lite.evaluate.table1 import evaluate
 from pgae_lite.model.build import build_model
 from pgae_lite.model.layers import ConcatBottleneck
 from pgae_lite.model.pgae import PGAE
@@ -54,12 +56,6 @@ from pgae_lite.util.storage import load_torch
 NO_BOTH = (3 / 8, 3 / 8, 1 / 8, 0.0, 1 / 8)        # ex-a1-no-both: describe, execute, repeat action, -, language
 SCENES = range(0, 36, 6)                          # chapter 03, section 6: push left slowly, arrangements 0-5
 SWAPS = [("red + blue", "blue + red"), ("green + red", "red + green"), ("blue + green", "green + blue")]
-
-
-def cells(trained, data, **options) -> dict:
-    """Table 1's cells of a trained model, rounded."""
-    found, _ = evaluate(trained.model, data, trained.normaliser, **options)
-    return {s: {k: None if v is None else round(v, 4) for k, v in c.items()} for s, c in found.items()}
 
 
 def final_bce(losses: list[float]) -> float:
@@ -303,6 +299,7 @@ EXERCISES = {
     "ex-bert-readout": (bert_readout, (0,)),
     "ex-family-share": (family_share, (0,)), "ex-family-noise": (family_noise, (0,)),
     "ex-a1-no-both": (a1_change("no-both"), (0,)), "ex-a1-concat": (a1_change("concat"), (0,)),
+    **ACTING,                                     # chapters 06 and 07, appendices A3 and A4
 }
 
 
