@@ -265,3 +265,12 @@ EXERCISES = {
     "ex-opp-mirror": (opp_mirror, (0,)), "ex-opp-prob": (opp_prob, (0,)), "ex-colour-cae": (colour_cae, (0,)),
     "ex-loop-measured": (loop_measured, (0,)), "ex-bert-finetune": (bert_finetune, (0,)),
 }
+
+
+if __name__ == "__main__":     # run as a script: the one entry point, benchmarks/exercise_runs.py, with these arguments
+    import runpy
+    import sys
+    from pathlib import Path
+
+    sys.argv[0] = str(Path(__file__).with_name("exercise_runs.py"))
+    runpy.run_path(sys.argv[0], run_name="__main__")

@@ -29,6 +29,8 @@ from pgae_lite.world.words import ACTIONS, COLOURS, SPEEDS
 SCENE = ("red", "blue")
 
 #: Refused in :data:`SCENE`: (text, a part of the reason).
+#:
+#: :meta hide-value:
 REFUSED = [
     ("don't push the red cube", "what not to do"),
     ("do not push the red cube, leave it alone", "what not to do"),
@@ -66,6 +68,8 @@ REFUSED = [
 ]
 
 #: Acted on in :data:`SCENE`.
+#:
+#: :meta hide-value:
 NOT_REFUSED = [
     "push the red cube, no rush",                             # a negated manner is no negation of the act
     "Please move the azure box away without hurrying",
@@ -85,12 +89,16 @@ NOT_REFUSED = [
 ]
 
 #: Without a scene only the words are judged: (text, a part of the reason or None).
+#:
+#: :meta hide-value:
 WITHOUT_SCENE = [
     ("push the green cube slowly", None),
     ("don't push the green cube", "what not to do"),
 ]
 
 #: The readback's colour is judged whether or not the words name one: (text, readback, a part of the reason or None).
+#:
+#: :meta hide-value:
 READBACK = [
     ("shove the thing away fast", "push yellow fast", "I understood 'push yellow fast'"),
     ("push the red cube fast", "push yellow fast", "I understood 'push yellow fast'"),   # named or not

@@ -21,7 +21,8 @@ does not have. Superseded files lie in ``results/history/`` and are named ``hist
 
 Every value read is checked before it is rendered (:mod:`pgae_lite.runs.result_checks`): text that
 renders as itself, finite numbers of a sane size, each figure in its measure's range (an accuracy
-in [0, 100], an nRMSE in [0, 100]); a failure is a :class:`ResultFileError` naming the file and the key.
+in [0, 100], an nRMSE in [0, 100]); a failure is a
+:class:`~pgae_lite.runs.result_checks.ResultFileError` naming the file and the key.
 ``python -m pgae_lite.runs.results --readme`` (:func:`write_readme`) rewrites the README's headline
 table atomically; a failure to read or write it is one sentence and leaves the README as it was.
 """

@@ -8,8 +8,8 @@ Whatever goes wrong there is one sentence, said before a run loads its data:
   is empty, malformed (``garbage``, ``tcp://``, ``host:notaport``) or of a scheme Dask's scheduler
   does not speak (``http://``) is an :class:`~pgae_lite.util.errors.ArgumentError` naming where it
   came from;
-- :func:`connect`: nobody answering within :data:`CONNECT_SECONDS`, something that is not a Dask
-  scheduler, or no worker joined within :data:`WORKERS_SECONDS` is a :class:`SchedulerError`;
+- :func:`connect`: nobody answering within ``CONNECT_SECONDS``, something that is not a Dask
+  scheduler, or no worker joined within ``WORKERS_SECONDS`` is a :class:`SchedulerError`;
 - :func:`lost`: the sentence for a scheduler lost in the middle of a sweep (what was saved, how to resume);
   :func:`disconnect` closes a client quietly, even when its scheduler is gone.
 """
@@ -112,7 +112,7 @@ def scheduler_address(scheduler: str | None = None, name: str = "scheduler") -> 
 
 def connect(scheduler: Scheduler, connect_seconds: float | None = None, workers_seconds: float | None = None):
     """A Dask client on ``scheduler``, once at least one worker has joined it; else a SchedulerError after
-    ``connect_seconds`` (default :data:`CONNECT_SECONDS`) or ``workers_seconds`` (:data:`WORKERS_SECONDS`)."""
+    ``connect_seconds`` (default ``CONNECT_SECONDS``) or ``workers_seconds`` (``WORKERS_SECONDS``)."""
     from distributed import Client
     from distributed.exceptions import WorkerStartTimeoutError
 

@@ -46,7 +46,7 @@ def save_checkpoint(path: Path, model: nn.Module, optimiser: torch.optim.Optimiz
     """Write a checkpoint atomically (a crash mid-write never leaves a broken file).
 
     A write that fails (a full disk, a read-only folder) raises
-    :class:`~pgae_lite.util.storage.OutputError` naming the file; the old checkpoint stays.
+    :class:`~pgae_lite.util.atomic_files.OutputError` naming the file; the old checkpoint stays.
     """
     save_torch({"model": model.state_dict(), "optimiser": optimiser.state_dict(),
                 "generator": gen.get_state(), "torch_rng": torch.get_rng_state(),

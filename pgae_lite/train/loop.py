@@ -113,7 +113,7 @@ def train(dataset: PGAEDataset, profile, out_dir: str | Path | None = None,
     ``checkpoint_every`` epochs and at the end (atomically); a later call with
     the same ``out_dir`` and profile resumes from it, and one whose training
     finished returns at once. While it runs, a lock file in ``out_dir`` makes a
-    second run there fail (:class:`~pgae_lite.util.storage.FolderBusyError`).
+    second run there fail (:class:`~pgae_lite.util.folder_lock.FolderBusyError`).
     ``callback(epoch, model, record)``, if given, is called after every epoch
     (e.g. to evaluate along the way). A NaN or infinite loss stops the run
     (:class:`NonFiniteLossError`, naming the epoch and the batch). ``name``: the model's, on the progress

@@ -71,7 +71,7 @@ class SavedFileNotFoundError(PGAELiteError, FileNotFoundError):
 
 def cache_dir() -> Path:
     """Root of every cache: ``$PGAE_LITE_CACHE``, else ``~/.cache/pgae_lite``; a file there, or the
-    variable set but empty, is refused with one sentence (:class:`OutputError`)."""
+    variable set but empty, is refused with one sentence (:class:`~pgae_lite.util.atomic_files.OutputError`)."""
     given = os.environ.get(CACHE_ENV)
     if given is not None and not given.strip():
         raise OutputError(f"{CACHE_ENV} is set but empty; unset it for ~/.cache/pgae_lite, or name a folder")
@@ -133,7 +133,7 @@ def array_digest(arrays: dict[str, np.ndarray]) -> str:
 
 
 def save_torch(obj, path: str | Path) -> None:
-    """``torch.save(obj, path)``, atomically; :class:`OutputError` if it fails."""
+    """``torch.save(obj, path)``, atomically; :class:`~pgae_lite.util.atomic_files.OutputError` if it fails."""
     path = Path(path)
     make_folder(path.parent)
     with atomic_path(path) as tmp:
