@@ -116,7 +116,8 @@ def atomic_write_text(path: str | Path, text: str, encoding: str = "utf-8") -> N
         f.write(text)
 
 
-def _alive(pid: int) -> bool:
+def alive(pid: int) -> bool:
+    """Whether a process ``pid`` runs on this machine (another user's counts)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -141,7 +142,7 @@ def atomic_folder(folder: str | Path) -> Iterator[Path]:
     left = re.compile(rf"{re.escape(folder.name)}\.(\d+)-[0-9a-f]{{8}}\.(?:tmp|old)")
     for path in parent.glob(f"{glob_escape(folder.name)}.*"):
         hit = left.fullmatch(path.name)
-        if hit and path.is_dir() and not path.is_symlink() and not _alive(int(hit.group(1))):
+        if hit and path.is_dir() and not path.is_symlink() and not alive(int(hit.group(1))):
             shutil.rmtree(path, ignore_errors=True)
     stem = f"{folder.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}"
     tmp, old = parent / f"{stem}.tmp", parent / f"{stem}.old"

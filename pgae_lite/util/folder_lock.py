@@ -18,7 +18,7 @@ import uuid
 from pathlib import Path
 from typing import Iterator
 
-from pgae_lite.util.atomic_files import OutputError, make_folder, why_failed
+from pgae_lite.util.atomic_files import OutputError, alive, make_folder, why_failed
 from pgae_lite.util.errors import PGAELiteError
 
 LOCK_FILE = ".pgae_lite.lock"
@@ -30,17 +30,6 @@ READ_ONLY = (errno.EROFS, errno.EACCES, errno.EPERM)
 
 class FolderBusyError(PGAELiteError, RuntimeError):
     """Another live process is training into the same output folder."""
-
-
-def _dead(pid: int) -> bool:
-    """Whether no process ``pid`` runs on this machine."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except PermissionError:
-        pass                          # alive, another user's
-    return False
 
 
 def _holder(lock: Path) -> str | None:
@@ -56,7 +45,7 @@ def _holder(lock: Path) -> str | None:
         return f"{host}:{pid}"
     if not pid.isdigit() or int(pid) == os.getpid():
         return None                   # unreadable, or left by this very process
-    return None if _dead(int(pid)) else f"{host}:{pid}"
+    return None if not alive(int(pid)) else f"{host}:{pid}"
 
 
 # What a run leaves when it is killed: its lock's link source, a taken-over lock, half-written files.
@@ -69,7 +58,7 @@ def clean_left_behind(folder: Path) -> list[Path]:
     for path in folder.rglob("*"):
         hit = _LEFT_BEHIND.fullmatch(path.name)
         if hit and path.is_file() and not path.is_symlink() and int(hit.group(1)) != os.getpid() \
-                and _dead(int(hit.group(1))):
+                and not alive(int(hit.group(1))):
             with contextlib.suppress(OSError):
                 path.unlink()
                 removed.append(path)
