@@ -80,6 +80,28 @@ def test_several_models_train_side_by_side_and_then_load(dask_cluster, monkeypat
         assert torch.equal(a, b)
 
 
+@pytest.mark.parametrize("cores, missing, expected", [(2, 3, 3), (2, 5, 4), (1, 2, 2), (4, 2, 2)])
+def test_missing_models_train_all_at_once_up_to_two_per_core(cores, missing, expected, monkeypatch):
+    """Three trainings on two cores train at once (they share the cores and end together, not two then
+    one), never more than two per core; the decision is trained_models' own, before any training starts."""
+    asked = {}
+
+    class Started(Exception):
+        pass
+
+    def sweep(work, units, *, workers, **_):
+        asked.update(workers=workers, units=len(units))
+        raise Started
+
+    monkeypatch.setattr(pipeline.os, "cpu_count", lambda: cores)
+    monkeypatch.setattr(pipeline, "run_sweep", sweep)
+    monkeypatch.setattr(pipeline, "is_trained", lambda *a: False)
+    trainings = [TRAININGS[n] for n in ("PGAE", "PGAE-no-plan", "PRAE-8", "PVAE", "PTAE")[:missing]]
+    with pytest.raises(Started):
+        pipeline.trained_models(trainings, SMOKE, device="cpu", progress=False)
+    assert asked == {"workers": expected, "units": missing}
+
+
 def test_a_model_another_process_is_training_is_waited_for(monkeypatch, capsys):
     """Two chapters side by side ask for one model: the second waits for the first's training, then loads it."""
     import shutil

@@ -4,7 +4,7 @@ On the profile's simulated data (:mod:`pgae_lite.runs.data`: simulator -> CAE ->
 each step cached), :func:`trained_model` trains one training of :mod:`pgae_lite.runs.rows` (a row's
 model of Table 1 or of the family, or a side training) by the one training loop, cached under the
 digests of its data and its recipe, so every chapter gets in seconds what an earlier chapter
-already trained; :func:`trained_models` trains several side by side, one per CPU core;
+already trained; :func:`trained_models` trains several at the same time, sharing the CPU's cores;
 :func:`load_model` reads a saved model back. Every function takes a
 :class:`~pgae_lite.config.Profile`, resolved once where the run starts.
 """
@@ -145,12 +145,15 @@ def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, d
 
     On a CPU the missing models train at the same time, each a unit of a sweep
     (:func:`pgae_lite.runs.sweep.run_sweep`) on a worker process of one thread, ``workers``
-    at once (default: one per core). These networks are small: on the book's 2-core
-    machine one training on both cores ran no faster than on one (A2, "Where the time
-    goes"), so two trainings side by side take about the time of one. With a GPU, or one
-    model to train, they train one after another in this process, as :func:`trained_model`
-    does. Workers are spawned, so a script that calls this needs the usual
-    ``if __name__ == "__main__":`` guard.
+    at once (default: all of them, up to two per core). These networks are small: on the
+    book's 2-core machine one training on both cores ran no faster than on one (A2, "Where
+    the time goes"), so two trainings side by side take about the time of one. Three
+    trainings of about equal length on two cores share the cores and end together, after
+    about one and a half trainings' time, where two at a time would take two. A worker has
+    one thread, so its model's numbers do not depend on how many run at once. With a GPU,
+    or one model to train, they train one after another in this process, as
+    :func:`trained_model` does. Workers are spawned, so a script that calls this needs the
+    usual ``if __name__ == "__main__":`` guard.
     """
     import torch
 
@@ -160,11 +163,12 @@ def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, d
     cpu = torch.device(device or default_device()).type == "cpu"
     dataset = _with_both_splits(loaded(SimulatedData(prof), device, progress))   # made before the workers read it
     todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed, dataset)]
-    workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
+    workers = max(1, min(workers or 2 * (os.cpu_count() or 1), len(todo)))     # more than cores: they share
     if cpu and workers > 1:
         if progress:
             names = ", ".join(t.name for t in todo)
-            print(f"training {names} side by side, {workers} at a time, one core each ...", flush=True)
+            print(f"training {names} side by side, {workers} at a time on {os.cpu_count()} cores, "
+                  "one thread each ...", flush=True)
         seconds = run_sweep(_train_alone, [(t, prof, seed) for t in todo], workers=workers, name="training",
                             progress=False)
         for training, s in zip(todo, seconds):
