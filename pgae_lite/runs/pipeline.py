@@ -163,11 +163,12 @@ def trained_models(trainings: list[Training], profile: Profile, seed: int = 0, d
     cpu = torch.device(device or default_device()).type == "cpu"
     dataset = _with_both_splits(loaded(SimulatedData(prof), device, progress))   # made before the workers read it
     todo = [t for t in {t.name: t for t in trainings}.values() if not is_trained(t, prof, seed, dataset)]
-    workers = max(1, min(workers or 2 * (os.cpu_count() or 1), len(todo)))     # more than cores: they share
+    cores = os.cpu_count() or 1
+    workers = max(1, min(workers or 2 * cores, len(todo)))     # more than cores: they share them
     if cpu and workers > 1:
         if progress:
             names = ", ".join(t.name for t in todo)
-            print(f"training {names} side by side, {workers} at a time on {os.cpu_count()} cores, "
+            print(f"training {names} side by side, {workers} at a time on {cores} cores, "
                   "one thread each ...", flush=True)
         seconds = run_sweep(_train_alone, [(t, prof, seed) for t in todo], workers=workers, name="training",
                             progress=False)

@@ -142,10 +142,11 @@ def run_sweep(work, units: list[tuple], *, workers: int | None = None, scheduler
                       flush=True)
         return results
     except (CancelledError, OSError) as e:          # Dask's: a task cancelled, a connection closed
-        if not is_lost(client, e) and not isinstance(e, CancelledError):
+        gone = is_lost(client, e)
+        if not gone and not isinstance(e, CancelledError):
             raise
         when = f"in the middle of the sweep {name!r}, with {done} of {len(units)} units done"
-        if not is_lost(client, e):
+        if not gone:
             when = f"or restarted (a unit was cancelled there) {when}"
         raise SchedulerError(lost(address, when, on_lost)) from e
     finally:

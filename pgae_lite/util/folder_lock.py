@@ -45,7 +45,7 @@ def _holder(lock: Path) -> str | None:
         return f"{host}:{pid}"
     if not pid.isdigit() or int(pid) == os.getpid():
         return None                   # unreadable, or left by this very process
-    return None if not alive(int(pid)) else f"{host}:{pid}"
+    return f"{host}:{pid}" if alive(int(pid)) else None
 
 
 # What a run leaves when it is killed: its lock's link source, a taken-over lock, half-written files.
